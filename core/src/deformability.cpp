@@ -1,0 +1,457 @@
+#include "pliant/core/deformability.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "pliant/core/curve_analysis.hpp"
+
+namespace pliant {
+namespace {
+
+template <int Dim, typename Scalar>
+Status check_inputs(const MsmModel<Dim, Scalar>& model, const ObservationSequence<Dim, Scalar>& obs,
+                    const DeformabilityConfig& config, const DeformabilityWorkspace<Dim, Scalar>& ws) noexcept {
+  if (!model.initialized() || !ws.state.initialized()) return Status::not_initialized;
+  if (config.grid_points < 3 || !(config.tolerance > 0) || config.max_refinements < 0 ||
+      !(config.alpha_min > 0) || !(config.alpha_min <= 1) || config.equilibrium_max_iterations < 1 ||
+      !(config.equilibrium_tolerance > 0)) {
+    return Status::invalid_argument;
+  }
+  if (ws.curve_capacity < config.grid_points + config.max_refinements) return Status::capacity_exceeded;
+  if (obs.frame_count < 2 || obs.particle_count != model.particle_count || obs.times_s == nullptr ||
+      obs.positions == nullptr || obs.driven_count < 0 || obs.driven_count > ws.driven_capacity ||
+      (obs.driven_count > 0 && obs.driven == nullptr)) {
+    return Status::invalid_argument;
+  }
+  for (int k = 0; k < obs.frame_count; ++k) {
+    if (!std::isfinite(obs.times_s[k]) || (k > 0 && !(obs.times_s[k] > obs.times_s[k - 1]))) {
+      return Status::invalid_argument;
+    }
+  }
+  for (int w = 0; w < obs.driven_count; ++w) {
+    const int id = obs.driven[w].id;
+    if (id < 0 || id >= model.particle_count || model.drivable[id] == 0) return Status::invalid_argument;
+  }
+  int free_particles = 0;
+  for (int i = 0; i < model.particle_count; ++i) {
+    if (model.fixed[i] == 0) ++free_particles;
+  }
+  // Particles driven for the whole recording are not free either.
+  for (int w = 0; w < obs.driven_count; ++w) {
+    const DrivenWindow& window = obs.driven[w];
+    if (window.active_at(obs.times_s[0]) && window.active_at(obs.times_s[obs.frame_count - 1]) &&
+        model.fixed[window.id] == 0) {
+      --free_particles;
+    }
+  }
+  return free_particles > 0 ? Status::ok : Status::no_free_particles;
+}
+
+// Driven targets for frame `k`: the particle's observation there, else its last target.
+template <int Dim, typename Scalar>
+int gather_targets(const ObservationSequence<Dim, Scalar>& obs, int k, const MsmState<Dim, Scalar>& state,
+                   DeformabilityWorkspace<Dim, Scalar>& ws) noexcept {
+  int count = 0;
+  const double t = obs.times_s[k];
+  for (int w = 0; w < obs.driven_count; ++w) {
+    const DrivenWindow& window = obs.driven[w];
+    if (!window.active_at(t)) {
+      ws.window_active[w] = 0;
+      continue;
+    }
+    if (ws.window_active[w] == 0) ws.held[w] = state.position[window.id];
+    ws.window_active[w] = 1;
+    if (obs.observed(k, window.id)) ws.held[w] = obs.point(k, window.id);
+    ws.target_ids[count] = window.id;
+    ws.targets[count] = ws.held[w];
+    ++count;
+  }
+  return count;
+}
+
+// Adds frame k's residuals of free observed particles to `error`.
+// With `residual_sum` ([particle_count]) and `samples` it also sums each particle's residuals
+// over frames, from which the estimator measures how much of the residual persists in time.
+template <int Dim, typename Scalar>
+void accumulate_frame(const MsmModel<Dim, Scalar>& model, const ObservationSequence<Dim, Scalar>& obs, int k,
+                      const MsmState<Dim, Scalar>& state, Eigen::Matrix<double, Dim, 1>* residual_sum,
+                      double* samples, TrajectoryError& error) noexcept {
+  long used = 0;
+  for (int i = 0; i < model.particle_count; ++i) {
+    if (model.fixed[i] != 0 || state.driven_now[i] != 0 || !obs.observed(k, i)) continue;
+    const Eigen::Matrix<double, Dim, 1> residual = (state.position[i] - obs.point(k, i)).template cast<double>();
+    const double squared = residual.squaredNorm();
+    error.sum_squares += squared;
+    error.mean_distance += std::sqrt(squared);
+    ++used;
+    if (residual_sum != nullptr) {
+      residual_sum[i] += residual;
+      samples[i] += 1.0;
+    }
+  }
+  if (used == 0) ++error.frames_without_observations;
+  error.count += used;
+}
+
+template <int Dim, typename Scalar>
+void run_trajectory(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>& params,
+                    const ObservationSequence<Dim, Scalar>& obs, DeformabilityWorkspace<Dim, Scalar>& ws,
+                    TrajectoryError& error) noexcept {
+  MsmState<Dim, Scalar>& state = ws.state;
+  msm_state_reset(model, state);
+  for (int w = 0; w < obs.driven_count; ++w) ws.window_active[w] = 0;
+  for (int i = 0; i < model.particle_count; ++i) {
+    ws.residual_sum[i].setZero();
+    ws.residual_samples[i] = 0;
+  }
+  (void)gather_targets(obs, 0, state, ws);
+  for (int k = 1; k < obs.frame_count; ++k) {
+    MsmStepInput<Dim, Scalar> input;
+    input.dt = static_cast<Scalar>(obs.times_s[k] - obs.times_s[k - 1]);
+    input.driven.count = gather_targets(obs, k, state, ws);
+    input.driven.ids = ws.target_ids;
+    input.driven.positions = ws.targets;
+    (void)msm_step(model, params, input, state);
+    accumulate_frame(model, obs, k, state, ws.residual_sum, ws.residual_samples, error);
+  }
+  for (int i = 0; i < model.particle_count; ++i) {
+    if (ws.residual_samples[i] > 0) {
+      error.between_squares += ws.residual_sum[i].squaredNorm() / ws.residual_samples[i];
+      ++error.compared_particles;
+    }
+  }
+}
+
+// Final-frame targets: the last observation of each window active at the final time.
+template <int Dim, typename Scalar>
+int final_targets(const MsmModel<Dim, Scalar>& model, const ObservationSequence<Dim, Scalar>& obs,
+                  DeformabilityWorkspace<Dim, Scalar>& ws) noexcept {
+  int count = 0;
+  const int last = obs.frame_count - 1;
+  for (int w = 0; w < obs.driven_count; ++w) {
+    const DrivenWindow& window = obs.driven[w];
+    if (!window.active_at(obs.times_s[last])) continue;
+    Eigen::Matrix<Scalar, Dim, 1> target = model.rest[window.id];
+    for (int k = last; k >= 0 && window.active_at(obs.times_s[k]); --k) {
+      if (obs.observed(k, window.id)) {
+        target = obs.point(k, window.id);
+        break;
+      }
+    }
+    ws.target_ids[count] = window.id;
+    ws.targets[count] = target;
+    ++count;
+  }
+  return count;
+}
+
+// Quasi-static relaxation to equilibrium, warm-started from the workspace state.
+template <int Dim, typename Scalar>
+void run_final(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>& params,
+               const ObservationSequence<Dim, Scalar>& obs, const DeformabilityConfig& config,
+               DeformabilityWorkspace<Dim, Scalar>& ws, TrajectoryError& error) noexcept {
+  MsmState<Dim, Scalar>& state = ws.state;
+  MsmStepInput<Dim, Scalar> input;
+  input.dt = static_cast<Scalar>((obs.times_s[obs.frame_count - 1] - obs.times_s[0]) / (obs.frame_count - 1));
+  input.driven.count = final_targets(model, obs, ws);
+  input.driven.ids = ws.target_ids;
+  input.driven.positions = ws.targets;
+  const double limit = config.equilibrium_tolerance * static_cast<double>(model.spacing);
+  error.converged = false;
+  for (int iteration = 0; iteration < config.equilibrium_max_iterations; ++iteration) {
+    for (int i = 0; i < model.particle_count; ++i) {
+      ws.previous[i] = state.position[i];
+      state.velocity[i].setZero();
+    }
+    (void)msm_step(model, params, input, state);
+    double largest = 0;
+    for (int i = 0; i < model.particle_count; ++i) {
+      largest = std::max(largest, static_cast<double>((state.position[i] - ws.previous[i]).norm()));
+    }
+    if (largest <= limit) {
+      error.converged = true;
+      break;
+    }
+  }
+  accumulate_frame(model, obs, obs.frame_count - 1, state, static_cast<Eigen::Matrix<double, Dim, 1>*>(nullptr),
+                   nullptr, error);
+}
+
+// Evaluations one beta search plans: grid, golden-section steps, three curvature probes.
+int planned_search_evaluations(const DeformabilityConfig& config) noexcept {
+  const double bracket = 2.0 / (config.grid_points - 1);
+  const int golden = static_cast<int>(std::ceil(std::log(bracket / config.tolerance) / std::log(1.618034))) + 2;
+  return config.grid_points + std::min(golden, config.max_refinements) + 3;
+}
+
+struct Progress {
+  const DeformabilityConfig* config = nullptr;
+  int done = 0;
+  int planned = 0;
+  void tick() noexcept {
+    ++done;
+    if (config->progress != nullptr) config->progress(config->progress_context, done, std::max(done, planned));
+  }
+};
+
+struct Sample {
+  double beta;
+  TrajectoryError error;
+};
+
+// One beta search at fixed alpha. Records the curve in the workspace when `record` is set.
+template <int Dim, typename Scalar>
+Status search_beta(const MsmModel<Dim, Scalar>& model, MsmParams<Dim, Scalar> params,
+                   const ObservationSequence<Dim, Scalar>& obs, const DeformabilityConfig& config,
+                   DeformabilityWorkspace<Dim, Scalar>& ws, bool record, Progress& progress,
+                   DeformabilityResult& result) noexcept {
+  int curve = 0;
+  Sample best{0, {}};
+  best.error.mean_distance = std::numeric_limits<double>::infinity();
+  int evaluations = 0;
+  bool any_observed = false;
+  auto evaluate = [&](double beta) -> TrajectoryError {
+    params.msm_beta = static_cast<Scalar>(beta);
+    TrajectoryError error;
+    (void)evaluate_deformability_error(model, params, obs, config, ws, error);
+    ++evaluations;
+    progress.tick();
+    if (!error.converged) ++result.unconverged_equilibria;
+    if (error.count > 0) any_observed = true;
+    if (record && curve < ws.curve_capacity) {
+      ws.curve_beta[curve] = beta;
+      ws.curve_error[curve] = error.mean_distance;
+      ++curve;
+    }
+    if (error.count > 0 && error.mean_distance < best.error.mean_distance) best = Sample{beta, error};
+    return error;
+  };
+
+  if (config.mode == FitMode::final_equilibrium) msm_state_reset(model, ws.state);
+  const int grid = config.grid_points;
+  int best_grid = 0;
+  double best_grid_error = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < grid; ++i) {
+    const double beta = static_cast<double>(i) / (grid - 1);
+    const TrajectoryError e = evaluate(beta);
+    if (e.count > 0 && e.mean_distance < best_grid_error) {
+      best_grid_error = e.mean_distance;
+      best_grid = i;
+    }
+  }
+  if (!any_observed) return Status::no_observations;
+  const bool grid_single = record ? single_basin(ws.curve_error, grid) : true;
+  result.frames_without_observations = best.error.frames_without_observations;
+
+  // Golden-section search inside the bracket of the best grid point's neighbours.
+  const double step = 1.0 / (grid - 1);
+  double lo = std::max(0.0, (best_grid - 1) * step);
+  double hi = std::min(1.0, (best_grid + 1) * step);
+  const double ratio = 0.5 * (std::sqrt(5.0) - 1.0);
+  double a = hi - ratio * (hi - lo);
+  double b = lo + ratio * (hi - lo);
+  double fa = evaluate(a).mean_distance;
+  double fb = evaluate(b).mean_distance;
+  for (int r = 2; r < config.max_refinements && hi - lo > config.tolerance; ++r) {
+    if (fa <= fb) {
+      hi = b;
+      b = a;
+      fb = fa;
+      a = hi - ratio * (hi - lo);
+      fa = evaluate(a).mean_distance;
+    } else {
+      lo = a;
+      a = b;
+      fa = fb;
+      b = lo + ratio * (hi - lo);
+      fb = evaluate(b).mean_distance;
+    }
+  }
+
+  // Uncertainty from the curvature of the sum of squares around the estimate.
+  const double h = std::max(0.01, 2.0 * config.tolerance);
+  const double centre = std::clamp(best.beta, h, 1.0 - h);
+  const TrajectoryError left = evaluate(centre - h);
+  const TrajectoryError middle = std::abs(centre - best.beta) < 1e-15 ? best.error : evaluate(centre);
+  const TrajectoryError right = evaluate(centre + h);
+  const ParabolaFit fit = fit_parabola(centre, h, left.sum_squares, middle.sum_squares, right.sum_squares);
+  const long scalars = best.error.count * Dim;
+
+  result.msm_beta = best.beta;
+  result.msm_alpha = static_cast<double>(params.msm_alpha);
+  // A particle's residuals are correlated in time: the rest shape and the tool path are observed
+  // with noise once and every frame inherits that. Treat each particle as a cluster of samples
+  // and widen the std by the design effect 1 + (m - 1) icc (m samples per particle, icc the
+  // share of residual variance that persists over the recording).
+  double design_effect = 1.0;
+  if (best.error.compared_particles > 0 && best.error.sum_squares > 0) {
+    const double per_particle = static_cast<double>(best.error.count) / best.error.compared_particles;
+    if (per_particle > 1.0) {
+      const double share = best.error.between_squares / best.error.sum_squares;
+      const double icc = std::clamp((share - 1.0 / per_particle) / (1.0 - 1.0 / per_particle), 0.0, 1.0);
+      design_effect = 1.0 + (per_particle - 1.0) * icc;
+      result.residual_correlation = icc;
+    }
+  }
+  result.msm_beta_std = least_squares_std(best.error.sum_squares, fit.curvature, scalars) * std::sqrt(design_effect);
+  result.unique_minimum = grid_single && fit.curvature > 0;
+  result.error = best.error.mean_distance;
+  result.residual_count = best.error.count;
+  result.rms = best.error.count > 0 ? std::sqrt(best.error.sum_squares / static_cast<double>(scalars)) : 0.0;
+  result.evaluations += evaluations;
+  if (record) {
+    // Insertion sort: the curve is small (grid + refinements) and must be ascending in beta.
+    for (int i = 1; i < curve; ++i) {
+      const double kb = ws.curve_beta[i];
+      const double ke = ws.curve_error[i];
+      int j = i - 1;
+      while (j >= 0 && ws.curve_beta[j] > kb) {
+        ws.curve_beta[j + 1] = ws.curve_beta[j];
+        ws.curve_error[j + 1] = ws.curve_error[j];
+        --j;
+      }
+      ws.curve_beta[j + 1] = kb;
+      ws.curve_error[j + 1] = ke;
+    }
+    result.curve_count = curve;
+  }
+  return Status::ok;
+}
+
+}  // namespace
+
+template <int Dim, typename Scalar>
+std::size_t deformability_workspace_size(const MsmModel<Dim, Scalar>& model, int driven_capacity,
+                                         const DeformabilityConfig& config) noexcept {
+  Arena measure;
+  DeformabilityWorkspace<Dim, Scalar> scratch;
+  (void)deformability_workspace_init(measure, model, driven_capacity, config, scratch);
+  return measure.required_bytes();
+}
+
+template <int Dim, typename Scalar>
+Status deformability_workspace_init(Arena& arena, const MsmModel<Dim, Scalar>& model, int driven_capacity,
+                                    const DeformabilityConfig& config,
+                                    DeformabilityWorkspace<Dim, Scalar>& workspace) noexcept {
+  using Vec = Eigen::Matrix<Scalar, Dim, 1>;
+  workspace = DeformabilityWorkspace<Dim, Scalar>{};
+  if (!model.initialized()) return Status::not_initialized;
+  if (driven_capacity < 0 || config.grid_points < 3 || config.max_refinements < 0) return Status::invalid_argument;
+  DeformabilityWorkspace<Dim, Scalar> ws;
+  const Status state_status = msm_state_init(arena, model, ws.state);
+  const auto driven = static_cast<std::size_t>(driven_capacity);
+  ws.driven_capacity = driven_capacity;
+  ws.target_ids = arena.carve<int>(driven);
+  ws.targets = arena.carve<Vec>(driven);
+  ws.held = arena.carve<Vec>(driven);
+  ws.window_active = arena.carve<std::uint8_t>(driven);
+  ws.previous = arena.carve<Vec>(static_cast<std::size_t>(model.particle_count));
+  ws.residual_sum = arena.carve<Eigen::Matrix<double, Dim, 1>>(static_cast<std::size_t>(model.particle_count));
+  ws.residual_samples = arena.carve<double>(static_cast<std::size_t>(model.particle_count));
+  ws.curve_capacity = config.grid_points + config.max_refinements + 4;
+  ws.curve_beta = arena.carve<double>(static_cast<std::size_t>(ws.curve_capacity));
+  ws.curve_error = arena.carve<double>(static_cast<std::size_t>(ws.curve_capacity));
+  if (arena.exhausted() || state_status != Status::ok) return Status::capacity_exceeded;
+  workspace = ws;
+  return Status::ok;
+}
+
+template <int Dim, typename Scalar>
+Status evaluate_deformability_error(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>& params,
+                                    const ObservationSequence<Dim, Scalar>& observations,
+                                    const DeformabilityConfig& config, DeformabilityWorkspace<Dim, Scalar>& workspace,
+                                    TrajectoryError& error) noexcept {
+  error = TrajectoryError{};
+  if (config.mode == FitMode::trajectory) {
+    run_trajectory(model, params, observations, workspace, error);
+  } else {
+    run_final(model, params, observations, config, workspace, error);
+  }
+  if (error.count == 0) return Status::no_observations;
+  error.mean_distance /= static_cast<double>(error.count);
+  return Status::ok;
+}
+
+template <int Dim, typename Scalar>
+Status estimate_deformability(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>& base,
+                              const ObservationSequence<Dim, Scalar>& observations, const DeformabilityConfig& config,
+                              DeformabilityWorkspace<Dim, Scalar>& workspace, DeformabilityResult& result) noexcept {
+  result = DeformabilityResult{};
+  const Status valid = check_inputs(model, observations, config, workspace);
+  if (valid != Status::ok) return valid;
+  Progress progress;
+  progress.config = &config;
+  progress.planned = planned_search_evaluations(config);
+  if (!config.estimate_alpha || config.mode != FitMode::trajectory) {
+    return search_beta(model, base, observations, config, workspace, true, progress, result);
+  }
+  // msm_alpha: coarse grid, then golden-section on the profile min_beta E(alpha, beta).
+  DeformabilityConfig inner = config;
+  inner.grid_points = std::min(config.grid_points, 6);
+  inner.tolerance = std::max(config.tolerance, 5e-3);
+  progress.planned = (5 + 14) * planned_search_evaluations(inner) + planned_search_evaluations(config);
+  MsmParams<Dim, Scalar> params = base;
+  auto profile = [&](double alpha) -> double {
+    params.msm_alpha = static_cast<Scalar>(alpha);
+    DeformabilityResult trial;
+    const Status s = search_beta(model, params, observations, inner, workspace, false, progress, trial);
+    result.evaluations += trial.evaluations;
+    return s == Status::ok ? trial.error : std::numeric_limits<double>::infinity();
+  };
+  constexpr int kAlphaGrid = 5;
+  double best_alpha = 1.0;
+  double best_value = std::numeric_limits<double>::infinity();
+  int best_index = kAlphaGrid - 1;
+  const double span = 1.0 - config.alpha_min;
+  for (int i = 0; i < kAlphaGrid; ++i) {
+    const double alpha = config.alpha_min + span * i / (kAlphaGrid - 1);
+    const double value = profile(alpha);
+    if (value < best_value) {
+      best_value = value;
+      best_alpha = alpha;
+      best_index = i;
+    }
+  }
+  double lo = config.alpha_min + span * std::max(0, best_index - 1) / (kAlphaGrid - 1);
+  double hi = config.alpha_min + span * std::min(kAlphaGrid - 1, best_index + 1) / (kAlphaGrid - 1);
+  const double ratio = 0.5 * (std::sqrt(5.0) - 1.0);
+  double a = hi - ratio * (hi - lo);
+  double b = lo + ratio * (hi - lo);
+  double fa = profile(a);
+  double fb = profile(b);
+  for (int r = 0; r < 12 && hi - lo > 5e-3; ++r) {
+    if (fa <= fb) {
+      hi = b; b = a; fb = fa; a = hi - ratio * (hi - lo); fa = profile(a);
+    } else {
+      lo = a; a = b; fa = fb; b = lo + ratio * (hi - lo); fb = profile(b);
+    }
+  }
+  const double candidate = fa <= fb ? a : b;
+  if (std::min(fa, fb) < best_value) best_alpha = candidate;
+  params.msm_alpha = static_cast<Scalar>(best_alpha);
+  const int spent = result.evaluations;
+  const Status status = search_beta(model, params, observations, config, workspace, true, progress, result);
+  result.evaluations += spent;
+  return status;
+}
+
+#define PLIANT_INSTANTIATE_DEFORMABILITY(DIM, SCALAR)                                                        \
+  template std::size_t deformability_workspace_size<DIM, SCALAR>(const MsmModel<DIM, SCALAR>&, int,          \
+                                                                 const DeformabilityConfig&) noexcept;       \
+  template Status deformability_workspace_init<DIM, SCALAR>(Arena&, const MsmModel<DIM, SCALAR>&, int,       \
+                                                            const DeformabilityConfig&,                      \
+                                                            DeformabilityWorkspace<DIM, SCALAR>&) noexcept;  \
+  template Status evaluate_deformability_error<DIM, SCALAR>(                                                \
+      const MsmModel<DIM, SCALAR>&, const MsmParams<DIM, SCALAR>&, const ObservationSequence<DIM, SCALAR>&, \
+      const DeformabilityConfig&, DeformabilityWorkspace<DIM, SCALAR>&, TrajectoryError&) noexcept;          \
+  template Status estimate_deformability<DIM, SCALAR>(                                                      \
+      const MsmModel<DIM, SCALAR>&, const MsmParams<DIM, SCALAR>&, const ObservationSequence<DIM, SCALAR>&, \
+      const DeformabilityConfig&, DeformabilityWorkspace<DIM, SCALAR>&, DeformabilityResult&) noexcept;
+PLIANT_INSTANTIATE_DEFORMABILITY(2, float)
+PLIANT_INSTANTIATE_DEFORMABILITY(2, double)
+PLIANT_INSTANTIATE_DEFORMABILITY(3, float)
+PLIANT_INSTANTIATE_DEFORMABILITY(3, double)
+#undef PLIANT_INSTANTIATE_DEFORMABILITY
+
+}  // namespace pliant

@@ -1,0 +1,235 @@
+#include "pliant/core/msm.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/LU>
+
+#include "pliant/core/polar.hpp"
+
+namespace pliant {
+namespace {
+
+template <typename Scalar>
+bool finite(Scalar value) noexcept {
+  return std::isfinite(value);
+}
+
+template <int Dim, typename Scalar>
+void identity_rotation(ClusterRotation<Dim, Scalar>& rotation) noexcept {
+  rotation.setIdentity();
+}
+
+// Rotation of `apq` into a matrix, updating the per-cluster warm start.
+template <typename Scalar>
+Eigen::Matrix<Scalar, 2, 2> rotation_of(const Eigen::Matrix<Scalar, 2, 2>& apq,
+                                        Eigen::Matrix<Scalar, 2, 2>& warm) noexcept {
+  (void)extract_rotation(apq, warm);
+  return warm;
+}
+template <typename Scalar>
+Eigen::Matrix<Scalar, 3, 3> rotation_of(const Eigen::Matrix<Scalar, 3, 3>& apq,
+                                        Eigen::Quaternion<Scalar>& warm) noexcept {
+  (void)extract_rotation(apq, warm);
+  return warm.toRotationMatrix();
+}
+
+// Mueller 2005 plasticity: the plastic state creeps toward the cluster's strain while the
+// strain exceeds the yield, is capped at `plastic_max` and kept volume-preserving.
+template <int Dim, typename Scalar>
+void update_plastic(const MsmParams<Dim, Scalar>& params, Scalar dt,
+                    const Eigen::Matrix<Scalar, Dim, Dim>& rotation,
+                    const Eigen::Matrix<Scalar, Dim, Dim>& affine_rest,
+                    Eigen::Matrix<Scalar, Dim, Dim>& plastic) noexcept {
+  using Mat = Eigen::Matrix<Scalar, Dim, Dim>;
+  const Scalar plastic_det = plastic.determinant();
+  if (!(plastic_det > Scalar(0))) {
+    plastic.setIdentity();
+    return;
+  }
+  // A (for the plastically deformed rest shape) = A0 S_p^-1; strain S = R^T A, symmetrised.
+  const Mat affine = affine_rest * plastic.inverse();
+  const Mat strain_full = rotation.transpose() * affine;
+  const Mat strain = Scalar(0.5) * (strain_full + strain_full.transpose());
+  const Mat identity = Mat::Identity();
+  if ((strain - identity).norm() <= params.plastic_yield) return;
+  Mat next = (identity + dt * params.plastic_creep * (strain - identity)) * plastic;
+  next = Scalar(0.5) * (next + next.transpose());
+  const Scalar excess = (next - identity).norm();
+  if (excess > params.plastic_max && excess > Scalar(0)) {
+    next = identity + (params.plastic_max / excess) * (next - identity);
+  }
+  const Scalar det = next.determinant();
+  if (!(det > Scalar(0)) || !next.allFinite()) return;
+  next /= std::pow(det, Scalar(1) / Scalar(Dim));
+  plastic = next;
+}
+
+}  // namespace
+
+template <int Dim, typename Scalar>
+std::size_t msm_state_workspace_size(const MsmModel<Dim, Scalar>& model) noexcept {
+  Arena measure;
+  MsmState<Dim, Scalar> scratch;
+  (void)msm_state_init(measure, model, scratch);
+  return measure.required_bytes();
+}
+
+template <int Dim, typename Scalar>
+Status msm_state_init(Arena& arena, const MsmModel<Dim, Scalar>& model, MsmState<Dim, Scalar>& state) noexcept {
+  using Vec = typename MsmState<Dim, Scalar>::Vec;
+  using Mat = typename MsmState<Dim, Scalar>::Mat;
+  state = MsmState<Dim, Scalar>{};
+  if (!model.initialized()) return Status::not_initialized;
+  const auto n = static_cast<std::size_t>(model.particle_count);
+  const auto c = static_cast<std::size_t>(model.cluster_count);
+  MsmState<Dim, Scalar> s;
+  s.position = arena.carve<Vec>(n);
+  s.velocity = arena.carve<Vec>(n);
+  s.predicted = arena.carve<Vec>(n);
+  s.goal_sum = arena.carve<Vec>(n);
+  s.driven_now = arena.carve<std::uint8_t>(n);
+  s.rotation = arena.carve<ClusterRotation<Dim, Scalar>>(c);
+  s.plastic = arena.carve<Mat>(c);
+  if (arena.exhausted()) return Status::capacity_exceeded;
+  state = s;
+  msm_state_reset(model, state);
+  return Status::ok;
+}
+
+template <int Dim, typename Scalar>
+void msm_state_reset(const MsmModel<Dim, Scalar>& model, MsmState<Dim, Scalar>& state) noexcept {
+  PLIANT_ASSERT(state.initialized() && model.initialized());
+  for (int i = 0; i < model.particle_count; ++i) {
+    state.position[i] = model.rest[i];
+    state.velocity[i].setZero();
+    state.driven_now[i] = 0;
+  }
+  for (int c = 0; c < model.cluster_count; ++c) {
+    identity_rotation<Dim, Scalar>(state.rotation[c]);
+    state.plastic[c].setIdentity();
+  }
+  state.time_s = 0;
+  state.steps = 0;
+}
+
+template <int Dim, typename Scalar>
+Status msm_step(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>& params,
+                const MsmStepInput<Dim, Scalar>& input, MsmState<Dim, Scalar>& state) noexcept {
+  using Vec = typename MsmState<Dim, Scalar>::Vec;
+  using Mat = typename MsmState<Dim, Scalar>::Mat;
+  if (!model.initialized() || !state.initialized()) return Status::not_initialized;
+  const Scalar dt = input.dt;
+  const bool params_ok = finite(params.msm_alpha) && params.msm_alpha > Scalar(0) &&
+                         params.msm_alpha <= Scalar(1) && finite(params.msm_beta) &&
+                         params.msm_beta >= Scalar(0) && params.msm_beta <= Scalar(1) &&
+                         params.gravity.allFinite() && finite(params.velocity_damping) &&
+                         params.velocity_damping >= Scalar(0);
+  if (!finite(dt) || !(dt > Scalar(0)) || !params_ok || input.driven.count < 0 ||
+      (input.driven.count > 0 && (input.driven.ids == nullptr || input.driven.positions == nullptr))) {
+    ++state.rejected_steps;
+    return Status::invalid_argument;
+  }
+  const int n = model.particle_count;
+  if (input.external_force != nullptr) {
+    for (int i = 0; i < n; ++i) {
+      if (!input.external_force[i].allFinite()) {
+        ++state.rejected_steps;
+        return Status::non_finite_input;
+      }
+    }
+  }
+
+  // 1. Prediction (eqs. 1-2). goal_sum doubles as the saved previous position.
+  const Scalar keep = std::max(Scalar(0), Scalar(1) - params.velocity_damping * dt);
+  for (int i = 0; i < n; ++i) {
+    const Vec& x = state.position[i];
+    state.driven_now[i] = 0;
+    state.goal_sum[i].setZero();
+    if (model.fixed[i] != 0) {
+      state.predicted[i] = model.rest[i];
+      continue;
+    }
+    Vec acceleration = params.gravity;
+    if (input.external_force != nullptr) acceleration += input.external_force[i] / model.mass[i];
+    const Vec v = (state.velocity[i] + dt * acceleration) * keep;
+    state.predicted[i] = x + dt * v;
+  }
+  Status result = Status::ok;
+  for (int k = 0; k < input.driven.count; ++k) {
+    const int id = input.driven.ids[k];
+    const Vec& target = input.driven.positions[k];
+    if (id < 0 || id >= n || model.drivable[id] == 0 || model.fixed[id] != 0 || !target.allFinite()) {
+      ++state.dropped_targets;
+      result = Status::non_finite_input;
+      continue;
+    }
+    state.predicted[id] = target;
+    state.driven_now[id] = 1;
+  }
+
+  // 2. Cluster shape matching (eqs. 3-13). Because sum m q0 = 0, A_pq = sum m x' q0^T, so one
+  // pass yields the centroid and A_pq.
+  const bool plastic_on = params.plastic_creep > Scalar(0);
+  for (int c = 0; c < model.cluster_count; ++c) {
+    const int begin = model.cluster_begin[c];
+    const int end = model.cluster_begin[c + 1];
+    Vec weighted_sum = Vec::Zero();
+    Mat apq_rest = Mat::Zero();
+    for (int k = begin; k < end; ++k) {
+      const int j = model.members[k];
+      const Vec mx = model.mass[j] * state.predicted[j];
+      weighted_sum += mx;
+      apq_rest.noalias() += mx * model.member_rest_offset[k].transpose();
+    }
+    const Vec centroid = weighted_sum * model.cluster_inverse_mass[c];
+    const Mat affine_rest = apq_rest * model.cluster_aqq_inverse[c];
+    const Mat& plastic = state.plastic[c];
+    const Mat rotation = plastic_on ? rotation_of(Mat(apq_rest * plastic.transpose()), state.rotation[c])
+                                    : rotation_of(apq_rest, state.rotation[c]);
+    const Scalar beta = params.cluster_beta != nullptr ? params.cluster_beta[c] : params.msm_beta;
+    // Goal map applied to q0: ((1 - beta) R + beta A) S_p q0 = (1 - beta) R S_p q0 + beta A0 q0.
+    const Mat goal_map = plastic_on ? Mat((Scalar(1) - beta) * rotation * plastic + beta * affine_rest)
+                                    : Mat((Scalar(1) - beta) * rotation + beta * affine_rest);
+    for (int k = begin; k < end; ++k) {
+      state.goal_sum[model.members[k]] += goal_map * model.member_rest_offset[k] + centroid;
+    }
+    if (plastic_on) update_plastic<Dim, Scalar>(params, dt, rotation, affine_rest, state.plastic[c]);
+  }
+
+  // 3. Integration (eqs. 10-11) with averaged goals.
+  const Scalar inverse_dt = Scalar(1) / dt;
+  for (int i = 0; i < n; ++i) {
+    const Vec previous = state.position[i];
+    Vec next;
+    if (model.fixed[i] != 0) {
+      next = model.rest[i];
+    } else if (state.driven_now[i] != 0) {
+      next = state.predicted[i];  // the goal of a driven particle is its target
+    } else if (model.inverse_cluster_count[i] > Scalar(0)) {
+      const Vec goal = state.goal_sum[i] * model.inverse_cluster_count[i];
+      next = state.predicted[i] + params.msm_alpha * (goal - state.predicted[i]);
+    } else {
+      next = state.predicted[i];
+    }
+    state.position[i] = next;
+    state.velocity[i] = (next - previous) * inverse_dt;
+  }
+  state.time_s += static_cast<double>(dt);
+  ++state.steps;
+  return result;
+}
+
+#define PLIANT_INSTANTIATE_MSM(DIM, SCALAR)                                                             \
+  template std::size_t msm_state_workspace_size<DIM, SCALAR>(const MsmModel<DIM, SCALAR>&) noexcept;   \
+  template Status msm_state_init<DIM, SCALAR>(Arena&, const MsmModel<DIM, SCALAR>&, MsmState<DIM, SCALAR>&) noexcept; \
+  template void msm_state_reset<DIM, SCALAR>(const MsmModel<DIM, SCALAR>&, MsmState<DIM, SCALAR>&) noexcept;   \
+  template Status msm_step<DIM, SCALAR>(const MsmModel<DIM, SCALAR>&, const MsmParams<DIM, SCALAR>&,      \
+                                        const MsmStepInput<DIM, SCALAR>&, MsmState<DIM, SCALAR>&) noexcept;
+PLIANT_INSTANTIATE_MSM(2, float)
+PLIANT_INSTANTIATE_MSM(2, double)
+PLIANT_INSTANTIATE_MSM(3, float)
+PLIANT_INSTANTIATE_MSM(3, double)
+#undef PLIANT_INSTANTIATE_MSM
+
+}  // namespace pliant

@@ -1,0 +1,736 @@
+// No-heap proof: every real-time core call, in 2D and 3D, float and double, makes zero heap
+// allocations and zero frees.
+//
+// How: tests/support/counting_allocator.cpp replaces the global operator new/delete (all
+// forms) and, on glibc without sanitizers, interposes malloc/calloc/realloc/free/memalign, so
+// any heap use by the core -- including Eigen code compiled into pliant::core -- is counted
+// while an AllocationCounter is armed. Everything the calls need (model, states, workspaces,
+// observations, targets, result storage) is built before arming; gtest assertions run only
+// after disarming (a failing assertion allocates its message).
+//
+// Eigen: this translation unit is compiled with EIGEN_RUNTIME_NO_MALLOC (see allocation.cmake)
+// and the counter calls Eigen::internal::set_is_malloc_allowed(false) while armed, so a
+// dynamic Eigen allocation made by inline Eigen code in this TU is reported as an
+// eigen_violation. pliant::core itself is compiled without EIGEN_RUNTIME_NO_MALLOC; that is
+// fine because the core uses only fixed-size Eigen types (Matrix<Scalar, Dim, 1>,
+// Matrix<Scalar, Dim, Dim>, Quaternion), which never touch the heap. Should that ever change,
+// the malloc interposition above still catches the allocation inside the core, because
+// Eigen's aligned_malloc ends in std::malloc.
+//
+// Defining EIGEN_RUNTIME_NO_MALLOC in one TU and not another changes only Eigen's
+// check_that_malloc_is_allowed(), which the fixed-size code paths shared with the core never
+// call.
+#include "support/counting_allocator.hpp"  // first: configures eigen_assert before any Eigen header
+
+#ifndef EIGEN_RUNTIME_NO_MALLOC
+#error "allocation_test.cpp must be compiled with EIGEN_RUNTIME_NO_MALLOC (see allocation.cmake)"
+#endif
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "pliant/core/deformability.hpp"
+#include "pliant/core/msm.hpp"
+#include "pliant/core/msm_model.hpp"
+#include "pliant/core/observations.hpp"
+#include "pliant/core/online_deformability.hpp"
+
+namespace pliant {
+namespace {
+
+using test::AllocationCounter;
+using test::AllocationCounts;
+
+std::string describe(const AllocationCounts& c) {
+  std::string text = "news=" + std::to_string(c.news) + " deletes=" + std::to_string(c.deletes) +
+                     " mallocs=" + std::to_string(c.mallocs) + " frees=" + std::to_string(c.frees) +
+                     " eigen_violations=" + std::to_string(c.eigen_violations);
+  if (c.eigen_expression != nullptr) text += std::string(" (first: ") + c.eigen_expression + ")";
+  if (!test::malloc_interposed()) text += " [malloc not interposed in this build]";
+  return text;
+}
+
+#define EXPECT_NO_HEAP(counts, what) EXPECT_EQ((counts).total(), 0u) << (what) << ": " << describe(counts)
+
+// --- counter sanity: the proof below cannot pass vacuously ------------------------------------
+
+TEST(AllocationCounterSanity, CountsPlainNew) {
+  int* volatile pointer = nullptr;  // volatile: the allocation cannot be elided
+  AllocationCounts counts;
+  {
+    AllocationCounter counter;
+    pointer = new int(42);
+    counts = counter.stop();
+  }
+  EXPECT_EQ(counts.news, 1u) << describe(counts);
+  EXPECT_EQ(counts.total(), 1u) << describe(counts);
+  delete pointer;
+}
+
+TEST(AllocationCounterSanity, CountsDeleteArrayAndAlignedForms) {
+  struct alignas(64) Wide {
+    double lane[8];
+  };
+  AllocationCounts counts;
+  {
+    AllocationCounter counter;
+    double* volatile array = new double[16];
+    Wide* volatile wide = new Wide;
+    int* volatile nothrow = new (std::nothrow) int(1);
+    delete[] array;
+    delete wide;
+    delete nothrow;
+    counts = counter.stop();
+  }
+  EXPECT_EQ(counts.news, 3u) << describe(counts);
+  EXPECT_EQ(counts.deletes, 3u) << describe(counts);
+}
+
+TEST(AllocationCounterSanity, CountsStandardContainers) {
+  AllocationCounts counts;
+  std::vector<double> values;
+  {
+    AllocationCounter counter;
+    values.resize(100);
+    counts = counter.stop();
+  }
+  EXPECT_GE(counts.total(), 1u) << describe(counts);
+}
+
+TEST(AllocationCounterSanity, CountsMallocWhenInterposed) {
+  if (!test::malloc_interposed()) {
+    GTEST_SKIP() << "malloc is not interposed in this build (sanitizer or non-glibc)";
+  }
+  AllocationCounts counts;
+  {
+    AllocationCounter counter;
+    void* volatile block = std::malloc(64);
+    std::free(block);
+    counts = counter.stop();
+  }
+  EXPECT_EQ(counts.mallocs, 1u) << describe(counts);
+  EXPECT_EQ(counts.frees, 1u) << describe(counts);
+}
+
+TEST(AllocationCounterSanity, CatchesDynamicEigenAllocation) {
+  AllocationCounts counts;
+  double sum = 0;
+  {
+    AllocationCounter counter;
+    Eigen::VectorXd dynamic = Eigen::VectorXd::Constant(64, 0.5);
+    sum = dynamic.sum();
+    counts = counter.stop();
+  }
+  EXPECT_DOUBLE_EQ(sum, 32.0);
+  EXPECT_GE(counts.eigen_violations, 1u) << describe(counts);
+  if (test::malloc_interposed()) {
+    EXPECT_GE(counts.mallocs, 1u) << describe(counts);
+  }
+}
+
+void allocate_in_progress(void* context, int, int) {
+  int* volatile leak_free = new int(1);  // volatile: the allocation cannot be elided
+  delete leak_free;
+  ++*static_cast<int*>(context);
+}
+
+// The counter sees allocations made from inside a pliant::core call (here by a progress
+// callback invoked from estimate_deformability), so a zero count below means the core made none.
+TEST(AllocationCounterSanity, SeesAllocationsInsideCoreCalls) {
+  std::vector<float> rest = {0, 0, 1, 0, 2, 0, 0, 1, 1, 1, 2, 1};
+  std::vector<std::uint8_t> fixed = {1, 1, 1, 0, 0, 0};
+  const int tool = 4;
+  MsmModelConfig<2, float> config;
+  config.particle_count = 6;
+  config.rest_positions = rest.data();
+  config.fixed = fixed.data();
+  config.drivable_ids = &tool;
+  config.drivable_count = 1;
+  std::vector<unsigned char> model_block(msm_model_workspace_size(config));
+  Arena model_arena(model_block.data(), model_block.size());
+  MsmModel<2, float> model;
+  ASSERT_EQ(msm_model_init(model_arena, config, model), Status::ok);
+  DeformabilityConfig fit;
+  int calls = 0;
+  fit.progress = &allocate_in_progress;
+  fit.progress_context = &calls;
+  std::vector<unsigned char> ws_block(deformability_workspace_size(model, 1, fit));
+  Arena ws_arena(ws_block.data(), ws_block.size());
+  DeformabilityWorkspace<2, float> workspace;
+  ASSERT_EQ(deformability_workspace_init(ws_arena, model, 1, fit, workspace), Status::ok);
+  std::vector<double> times = {0.0, 0.1, 0.2};
+  std::vector<float> positions;
+  for (int k = 0; k < 3; ++k) {
+    for (std::size_t i = 0; i < rest.size(); ++i) {
+      positions.push_back(rest[i] - (i == 9 ? 0.1f * static_cast<float>(k) : 0.0f));
+    }
+  }
+  DrivenWindow window;
+  window.id = tool;
+  ObservationSequence<2, float> observations;
+  observations.frame_count = 3;
+  observations.particle_count = 6;
+  observations.times_s = times.data();
+  observations.positions = positions.data();
+  observations.driven = &window;
+  observations.driven_count = 1;
+  DeformabilityResult result;
+  Status status = Status::not_initialized;
+  AllocationCounts counts;
+  {
+    AllocationCounter counter;
+    status = estimate_deformability(model, MsmParams<2, float>{}, observations, fit, workspace, result);
+    counts = counter.stop();
+  }
+  ASSERT_EQ(status, Status::ok);
+  ASSERT_GT(calls, 0);
+  EXPECT_EQ(counts.news, static_cast<std::size_t>(calls)) << describe(counts);
+  EXPECT_EQ(counts.deletes, static_cast<std::size_t>(calls)) << describe(counts);
+}
+
+TEST(AllocationCounterSanity, QuietWhenDisarmed) {
+  AllocationCounter counter;
+  const AllocationCounts before = counter.stop();
+  int* volatile pointer = new int(7);
+  delete pointer;
+  EXPECT_EQ(counter.counts().total(), before.total());
+  EXPECT_EQ(before.total(), 0u) << describe(before);
+}
+
+// --- the scene: a small press experiment, all memory allocated up front ----------------------
+
+// 2D: 8 columns x 4 rows (the paper's layout); 3D: 4 x 4 x 3. Bottom layer fixed; the
+// top-centre particle (`tool`) is pressed down a third of the spacing over 0.5 s and held;
+// `helper` is a second drivable top particle used by the msm_step tests. The observations
+// are a noise-free truth run (beta 0.4) of the same model, so the estimators have a known
+// answer.
+template <int Dim, typename Scalar>
+struct Scene {
+  using Vec = Eigen::Matrix<Scalar, Dim, 1>;
+  static constexpr int kFrames = 31;
+  static constexpr double kRateHz = 30.0;
+  static constexpr double kSpacing = 0.01;
+  static constexpr double kTruthBeta = 0.4;
+
+  int cols = Dim == 2 ? 8 : 4;
+  int rows = 4;
+  int layers = Dim == 2 ? 1 : 3;
+  int n = 0;
+  int tool = 0;
+  int helper = 0;
+  std::vector<Scalar> rest;
+  std::vector<std::uint8_t> fixed;
+  std::vector<int> drivable;
+  std::vector<unsigned char> model_block;
+  MsmModel<Dim, Scalar> model;
+
+  std::vector<double> times;
+  std::vector<Scalar> positions;  // [frame][particle][axis]
+  std::vector<Vec> frames;        // same data as vectors, [frame * n + particle]
+  std::vector<Vec> tool_targets;  // [frame]
+  DrivenWindow window;
+  ObservationSequence<Dim, Scalar> observations;
+
+  static constexpr int down_axis() { return Dim - 1; }
+
+  int id(int col, int row, int layer) const { return Dim == 2 ? row * cols + col : (layer * rows + row) * cols + col; }
+
+  Status build() {
+    n = cols * rows * layers;
+    for (int l = 0; l < layers; ++l) {
+      for (int r = 0; r < rows; ++r) {
+        for (int c = 0; c < cols; ++c) {
+          rest.push_back(static_cast<Scalar>(kSpacing * c));
+          if (Dim == 2) {
+            rest.push_back(static_cast<Scalar>(kSpacing * r));
+          } else {
+            rest.push_back(static_cast<Scalar>(kSpacing * r));
+            rest.push_back(static_cast<Scalar>(kSpacing * l));
+          }
+        }
+      }
+    }
+    fixed.assign(static_cast<std::size_t>(n), 0);
+    // The bottom layer: row 0 in 2D, layer 0 in 3D.
+    for (int i = 0; i < n; ++i) {
+      if (rest[static_cast<std::size_t>(i * Dim + down_axis())] == Scalar(0)) fixed[static_cast<std::size_t>(i)] = 1;
+    }
+    tool = Dim == 2 ? id(cols / 2, rows - 1, 0) : id(cols / 2, rows / 2, layers - 1);
+    helper = Dim == 2 ? id(1, rows - 1, 0) : id(0, 0, layers - 1);
+    drivable = {tool, helper};
+
+    MsmModelConfig<Dim, Scalar> config;
+    config.particle_count = n;
+    config.rest_positions = rest.data();
+    config.fixed = fixed.data();
+    config.drivable_ids = drivable.data();
+    config.drivable_count = static_cast<int>(drivable.size());
+    config.driven_mass_factor = 2.0;
+    const std::size_t model_bytes = msm_model_workspace_size(config);
+    if (model_bytes == 0) return Status::invalid_argument;
+    model_block.resize(model_bytes);
+    Arena arena(model_block.data(), model_block.size());
+    const Status built = msm_model_init(arena, config, model);
+    if (built != Status::ok) return built;
+
+    // Truth run.
+    std::vector<unsigned char> truth_block(msm_state_workspace_size(model));
+    Arena truth_arena(truth_block.data(), truth_block.size());
+    MsmState<Dim, Scalar> truth;
+    const Status state_ok = msm_state_init(truth_arena, model, truth);
+    if (state_ok != Status::ok) return state_ok;
+    MsmParams<Dim, Scalar> params;
+    params.msm_beta = static_cast<Scalar>(kTruthBeta);
+    const double dt = 1.0 / kRateHz;
+    auto record = [&] {
+      for (int i = 0; i < n; ++i) {
+        frames.push_back(truth.position[i]);
+        for (int d = 0; d < Dim; ++d) positions.push_back(truth.position[i](d));
+      }
+      tool_targets.push_back(truth.position[tool]);
+    };
+    times.push_back(0.0);
+    record();
+    for (int k = 1; k < kFrames; ++k) {
+      const double t = k * dt;
+      Vec target = model.rest[tool];
+      target(down_axis()) -= static_cast<Scalar>(kSpacing / 3.0 * std::min(1.0, t / 0.5));
+      MsmStepInput<Dim, Scalar> input;
+      input.dt = static_cast<Scalar>(dt);
+      input.driven.ids = &tool;
+      input.driven.positions = &target;
+      input.driven.count = 1;
+      const Status stepped = msm_step(model, params, input, truth);
+      if (stepped != Status::ok) return stepped;
+      times.push_back(t);
+      record();
+    }
+    window.id = tool;  // driven for the whole recording
+    observations.frame_count = kFrames;
+    observations.particle_count = n;
+    observations.times_s = times.data();
+    observations.positions = positions.data();
+    observations.driven = &window;
+    observations.driven_count = 1;
+    return Status::ok;
+  }
+
+  const Vec* frame(int k) const { return frames.data() + static_cast<std::ptrdiff_t>(k) * n; }
+};
+
+template <int D, typename S>
+struct Case {
+  static constexpr int kDim = D;
+  using Scalar = S;
+};
+
+template <typename C>
+class RealTimeAllocation : public ::testing::Test {
+ protected:
+  // Distinct names so the test bodies' local Dim / Scalar / Vec / scene do not shadow them.
+  static constexpr int kFixtureDim = C::kDim;
+  using FixtureScalar = typename C::Scalar;
+  using FixtureVec = Eigen::Matrix<FixtureScalar, kFixtureDim, 1>;
+
+  void SetUp() override { ASSERT_EQ(scene_.build(), Status::ok); }
+
+  // A state in its own block.
+  struct OwnedState {
+    std::vector<unsigned char> block;
+    MsmState<kFixtureDim, FixtureScalar> state;
+  };
+  void make_state(OwnedState& owned) {
+    owned.block.resize(msm_state_workspace_size(scene_.model));
+    Arena arena(owned.block.data(), owned.block.size());
+    ASSERT_EQ(msm_state_init(arena, scene_.model, owned.state), Status::ok);
+  }
+
+  struct OwnedWorkspace {
+    std::vector<unsigned char> block;
+    DeformabilityWorkspace<kFixtureDim, FixtureScalar> workspace;
+  };
+  void make_workspace(const DeformabilityConfig& config, OwnedWorkspace& owned) {
+    owned.block.resize(deformability_workspace_size(scene_.model, 1, config));
+    Arena arena(owned.block.data(), owned.block.size());
+    ASSERT_EQ(deformability_workspace_init(arena, scene_.model, 1, config, owned.workspace), Status::ok);
+  }
+
+  bool state_finite(const MsmState<kFixtureDim, FixtureScalar>& state) const {
+    for (int i = 0; i < scene_.n; ++i) {
+      if (!state.position[i].allFinite() || !state.velocity[i].allFinite()) return false;
+    }
+    return true;
+  }
+
+  Scene<kFixtureDim, FixtureScalar> scene_;
+};
+
+struct CaseNames {
+  template <typename C>
+  static std::string GetName(int) {
+    return std::to_string(C::kDim) + "d_" + (std::is_same<typename C::Scalar, float>::value ? "float" : "double");
+  }
+};
+
+using Cases = ::testing::Types<Case<2, float>, Case<2, double>, Case<3, float>, Case<3, double>>;
+TYPED_TEST_SUITE(RealTimeAllocation, Cases, CaseNames);
+
+void count_progress(void* context, int, int) { ++*static_cast<int*>(context); }
+
+// msm_step with every feature on: two driven targets moving, external forces, gravity,
+// damping, plasticity and per-cluster beta.
+TYPED_TEST(RealTimeAllocation, MsmStepWithAllFeatures) {
+  using Scalar = typename TestFixture::FixtureScalar;
+  using Vec = typename TestFixture::FixtureVec;
+  constexpr int Dim = TestFixture::kFixtureDim;
+  const auto& scene = this->scene_;
+  typename TestFixture::OwnedState owned;
+  this->make_state(owned);
+  MsmState<Dim, Scalar>& state = owned.state;
+
+  std::vector<Scalar> cluster_beta(static_cast<std::size_t>(scene.model.cluster_count));
+  for (std::size_t c = 0; c < cluster_beta.size(); ++c) {
+    cluster_beta[c] = static_cast<Scalar>(0.1 + 0.8 * static_cast<double>(c) / static_cast<double>(cluster_beta.size()));
+  }
+  MsmParams<Dim, Scalar> params;
+  params.msm_alpha = Scalar(0.9);
+  params.msm_beta = Scalar(0.3);
+  params.cluster_beta = cluster_beta.data();
+  params.gravity = Vec::Zero();
+  params.gravity(Dim - 1) = Scalar(-9.81);
+  params.velocity_damping = Scalar(2);
+  params.plastic_yield = Scalar(0.01);
+  params.plastic_creep = Scalar(5);
+  params.plastic_max = Scalar(0.5);
+
+  std::vector<Vec> forces(static_cast<std::size_t>(scene.n), Vec::Zero());
+  for (int i = 0; i < scene.n; ++i) forces[static_cast<std::size_t>(i)](0) = static_cast<Scalar>(0.01 * (i % 3));
+
+  constexpr int kSteps = 60;
+  const int ids[2] = {scene.tool, scene.helper};
+  std::vector<Vec> targets(2 * kSteps);
+  for (int k = 0; k < kSteps; ++k) {
+    const double depth = Scene<Dim, Scalar>::kSpacing * 0.4 * std::sin(0.1 * k);
+    targets[static_cast<std::size_t>(2 * k)] = scene.model.rest[scene.tool];
+    targets[static_cast<std::size_t>(2 * k)](Dim - 1) -= static_cast<Scalar>(depth);
+    targets[static_cast<std::size_t>(2 * k + 1)] = scene.model.rest[scene.helper];
+    targets[static_cast<std::size_t>(2 * k + 1)](0) += static_cast<Scalar>(depth);
+  }
+  std::vector<Status> statuses(kSteps, Status::not_initialized);
+
+  AllocationCounts counts;
+  {
+    AllocationCounter counter;
+    for (int k = 0; k < kSteps; ++k) {
+      MsmStepInput<Dim, Scalar> input;
+      input.dt = Scalar(1) / Scalar(100);
+      input.driven.ids = ids;
+      input.driven.positions = targets.data() + 2 * k;
+      input.driven.count = 2;
+      input.external_force = forces.data();
+      statuses[static_cast<std::size_t>(k)] = msm_step(scene.model, params, input, state);
+    }
+    counts = counter.stop();
+  }
+  EXPECT_NO_HEAP(counts, "msm_step");
+  for (int k = 0; k < kSteps; ++k) EXPECT_EQ(statuses[static_cast<std::size_t>(k)], Status::ok) << "step " << k;
+  EXPECT_EQ(state.steps, static_cast<std::uint32_t>(kSteps));
+  EXPECT_EQ(state.dropped_targets, 0u);
+  EXPECT_TRUE(this->state_finite(state));
+  // The plastic path really ran: some cluster yielded.
+  bool yielded = false;
+  for (int c = 0; c < scene.model.cluster_count; ++c) {
+    if (!state.plastic[c].isIdentity(Scalar(1e-4))) yielded = true;
+  }
+  EXPECT_TRUE(yielded) << "plasticity never engaged; the test does not cover update_plastic";
+}
+
+TYPED_TEST(RealTimeAllocation, MsmStateReset) {
+  using Scalar = typename TestFixture::FixtureScalar;
+  constexpr int Dim = TestFixture::kFixtureDim;
+  const auto& scene = this->scene_;
+  typename TestFixture::OwnedState owned;
+  this->make_state(owned);
+  MsmState<Dim, Scalar>& state = owned.state;
+  MsmParams<Dim, Scalar> params;
+  params.msm_beta = Scalar(0.5);
+  for (int k = 1; k < Scene<Dim, Scalar>::kFrames; ++k) {
+    MsmStepInput<Dim, Scalar> input;
+    input.dt = Scalar(1) / Scalar(30);
+    input.driven.ids = &scene.tool;
+    input.driven.positions = &scene.tool_targets[static_cast<std::size_t>(k)];
+    input.driven.count = 1;
+    ASSERT_EQ(msm_step(scene.model, params, input, state), Status::ok);
+  }
+  ASSERT_NE(state.position[scene.tool], scene.model.rest[scene.tool]);
+
+  AllocationCounts counts;
+  {
+    AllocationCounter counter;
+    msm_state_reset(scene.model, state);
+    counts = counter.stop();
+  }
+  EXPECT_NO_HEAP(counts, "msm_state_reset");
+  EXPECT_EQ(state.steps, 0u);
+  for (int i = 0; i < scene.n; ++i) {
+    EXPECT_EQ(state.position[i], scene.model.rest[i]) << "particle " << i;
+    EXPECT_TRUE(state.velocity[i].isZero(Scalar(0))) << "particle " << i;
+  }
+}
+
+// Bad inputs are refused or dropped with their documented status, and without heap use.
+TYPED_TEST(RealTimeAllocation, MsmStepBadInputs) {
+  using Scalar = typename TestFixture::FixtureScalar;
+  using Vec = typename TestFixture::FixtureVec;
+  constexpr int Dim = TestFixture::kFixtureDim;
+  const auto& scene = this->scene_;
+  typename TestFixture::OwnedState owned;
+  this->make_state(owned);
+  MsmState<Dim, Scalar>& state = owned.state;
+  MsmParams<Dim, Scalar> params;
+  params.msm_beta = Scalar(0.5);
+  const Scalar nan = std::numeric_limits<Scalar>::quiet_NaN();
+  const Scalar inf = std::numeric_limits<Scalar>::infinity();
+
+  // Move away from rest first so "state unchanged" is a meaningful check.
+  for (int k = 1; k < 10; ++k) {
+    MsmStepInput<Dim, Scalar> input;
+    input.dt = Scalar(1) / Scalar(30);
+    input.driven.ids = &scene.tool;
+    input.driven.positions = &scene.tool_targets[static_cast<std::size_t>(k)];
+    input.driven.count = 1;
+    ASSERT_EQ(msm_step(scene.model, params, input, state), Status::ok);
+  }
+  std::vector<Vec> before(static_cast<std::size_t>(scene.n));
+  std::vector<Vec> after_rejections(static_cast<std::size_t>(scene.n));
+  const Vec good_target = scene.tool_targets[10];
+  Vec nan_target = good_target;
+  nan_target(0) = nan;
+  Vec inf_target = good_target;
+  inf_target(Dim - 1) = -inf;
+  std::vector<Vec> nan_forces(static_cast<std::size_t>(scene.n), Vec::Zero());
+  nan_forces[static_cast<std::size_t>(scene.n - 1)](0) = nan;
+  const std::uint32_t steps0 = state.steps;
+  const std::uint32_t dropped0 = state.dropped_targets;
+  const std::uint32_t rejected0 = state.rejected_steps;
+  std::uint32_t steps_after_rejections = 0;
+
+  Status nan_dt = Status::ok, inf_dt = Status::ok, zero_dt = Status::ok, negative_dt = Status::ok;
+  Status nan_force = Status::ok, nan_target_status = Status::ok, inf_target_status = Status::ok;
+  AllocationCounts counts;
+  {
+    AllocationCounter counter;
+    for (int i = 0; i < scene.n; ++i) before[static_cast<std::size_t>(i)] = state.position[i];
+    MsmStepInput<Dim, Scalar> input;
+    input.driven.ids = &scene.tool;
+    input.driven.positions = &good_target;
+    input.driven.count = 1;
+    input.dt = nan;
+    nan_dt = msm_step(scene.model, params, input, state);
+    input.dt = inf;
+    inf_dt = msm_step(scene.model, params, input, state);
+    input.dt = Scalar(0);
+    zero_dt = msm_step(scene.model, params, input, state);
+    input.dt = Scalar(-0.01);
+    negative_dt = msm_step(scene.model, params, input, state);
+    input.dt = Scalar(1) / Scalar(30);
+    input.external_force = nan_forces.data();
+    nan_force = msm_step(scene.model, params, input, state);
+    for (int i = 0; i < scene.n; ++i) after_rejections[static_cast<std::size_t>(i)] = state.position[i];
+    steps_after_rejections = state.steps;
+    input.external_force = nullptr;
+    input.driven.positions = &nan_target;
+    nan_target_status = msm_step(scene.model, params, input, state);
+    input.driven.positions = &inf_target;
+    inf_target_status = msm_step(scene.model, params, input, state);
+    counts = counter.stop();
+  }
+  EXPECT_NO_HEAP(counts, "msm_step with bad inputs");
+  // Rejected steps: invalid_argument for a bad dt, non_finite_input for a bad force; state unchanged.
+  EXPECT_EQ(nan_dt, Status::invalid_argument);
+  EXPECT_EQ(inf_dt, Status::invalid_argument);
+  EXPECT_EQ(zero_dt, Status::invalid_argument);
+  EXPECT_EQ(negative_dt, Status::invalid_argument);
+  EXPECT_EQ(nan_force, Status::non_finite_input);
+  EXPECT_EQ(steps_after_rejections, steps0);
+  for (int i = 0; i < scene.n; ++i) {
+    EXPECT_EQ(after_rejections[static_cast<std::size_t>(i)], before[static_cast<std::size_t>(i)]) << "particle " << i;
+  }
+  // Dropped targets: the step runs, the target is counted, the status says non_finite_input.
+  EXPECT_EQ(nan_target_status, Status::non_finite_input);
+  EXPECT_EQ(inf_target_status, Status::non_finite_input);
+  EXPECT_EQ(state.rejected_steps, rejected0 + 5);
+  EXPECT_EQ(state.dropped_targets, dropped0 + 2);
+  EXPECT_EQ(state.steps, steps0 + 2);
+  EXPECT_TRUE(this->state_finite(state)) << "a non-finite input reached the state";
+}
+
+TYPED_TEST(RealTimeAllocation, OnlineDeformability) {
+  using Scalar = typename TestFixture::FixtureScalar;
+  using Vec = typename TestFixture::FixtureVec;
+  constexpr int Dim = TestFixture::kFixtureDim;
+  const auto& scene = this->scene_;
+  OnlineDeformabilityConfig config;
+  config.candidates = 11;
+  config.forgetting = 0.99;
+  std::vector<unsigned char> block(online_deformability_workspace_size(scene.model, config));
+  Arena arena(block.data(), block.size());
+  OnlineDeformability<Dim, Scalar> estimator;
+  ASSERT_EQ(online_deformability_init(arena, scene.model, MsmParams<Dim, Scalar>{}, config, estimator), Status::ok);
+  // Run once before the measured pass so the measured reset has real state to clear.
+  const Scalar dt = Scalar(1) / Scalar(30);
+  MsmDrivenTargets<Dim, Scalar> driven;
+  driven.ids = &scene.tool;
+  driven.count = 1;
+  for (int k = 1; k < Scene<Dim, Scalar>::kFrames; ++k) {
+    driven.positions = &scene.tool_targets[static_cast<std::size_t>(k)];
+    ASSERT_EQ(online_deformability_update(scene.model, estimator, dt, driven, scene.frame(k)), Status::ok);
+  }
+  std::vector<Vec> unobserved(static_cast<std::size_t>(scene.n), Vec::Constant(std::numeric_limits<Scalar>::quiet_NaN()));
+  std::vector<Status> statuses(Scene<Dim, Scalar>::kFrames, Status::not_initialized);
+  OnlineDeformabilityEstimate estimate;
+  Status empty = Status::ok, rejected = Status::ok;
+
+  AllocationCounts counts;
+  {
+    AllocationCounter counter;
+    online_deformability_reset(scene.model, estimator);
+    for (int k = 1; k < Scene<Dim, Scalar>::kFrames; ++k) {
+      driven.positions = &scene.tool_targets[static_cast<std::size_t>(k)];
+      statuses[static_cast<std::size_t>(k)] = online_deformability_update(scene.model, estimator, dt, driven, scene.frame(k));
+    }
+    estimate = online_deformability_estimate(estimator);
+    empty = online_deformability_update(scene.model, estimator, dt, driven, unobserved.data());
+    rejected = online_deformability_update(scene.model, estimator, std::numeric_limits<Scalar>::quiet_NaN(), driven,
+                                           scene.frame(1));
+    counts = counter.stop();
+  }
+  EXPECT_NO_HEAP(counts, "online_deformability reset/update/estimate");
+  for (int k = 1; k < Scene<Dim, Scalar>::kFrames; ++k) EXPECT_EQ(statuses[static_cast<std::size_t>(k)], Status::ok) << k;
+  EXPECT_EQ(empty, Status::no_observations);
+  EXPECT_EQ(rejected, Status::invalid_argument);
+  EXPECT_EQ(estimate.frames, static_cast<std::uint32_t>(Scene<Dim, Scalar>::kFrames - 1));
+  const double truth_beta = Scene<Dim, Scalar>::kTruthBeta;
+  EXPECT_NEAR(estimate.msm_beta, truth_beta, 0.1);
+}
+
+TYPED_TEST(RealTimeAllocation, EstimateTrajectory) {
+  using Scalar = typename TestFixture::FixtureScalar;
+  constexpr int Dim = TestFixture::kFixtureDim;
+  const auto& scene = this->scene_;
+  DeformabilityConfig config;
+  config.mode = FitMode::trajectory;
+  int progress_calls = 0;
+  config.progress = &count_progress;
+  config.progress_context = &progress_calls;
+  typename TestFixture::OwnedWorkspace owned;
+  this->make_workspace(config, owned);
+  DeformabilityResult result;
+  Status status = Status::not_initialized;
+  AllocationCounts counts;
+  {
+    AllocationCounter counter;
+    status = estimate_deformability(scene.model, MsmParams<Dim, Scalar>{}, scene.observations, config, owned.workspace,
+                                    result);
+    counts = counter.stop();
+  }
+  EXPECT_NO_HEAP(counts, "estimate_deformability (trajectory)");
+  ASSERT_EQ(status, Status::ok);
+  EXPECT_GT(result.evaluations, config.grid_points);
+  EXPECT_EQ(progress_calls, result.evaluations);
+  const double truth_beta = Scene<Dim, Scalar>::kTruthBeta;
+  EXPECT_NEAR(result.msm_beta, truth_beta, 0.05);
+}
+
+TYPED_TEST(RealTimeAllocation, EstimateFinalEquilibrium) {
+  using Scalar = typename TestFixture::FixtureScalar;
+  constexpr int Dim = TestFixture::kFixtureDim;
+  const auto& scene = this->scene_;
+  DeformabilityConfig config;
+  config.mode = FitMode::final_equilibrium;
+  typename TestFixture::OwnedWorkspace owned;
+  this->make_workspace(config, owned);
+  DeformabilityResult result;
+  Status status = Status::not_initialized;
+  AllocationCounts counts;
+  {
+    AllocationCounter counter;
+    status = estimate_deformability(scene.model, MsmParams<Dim, Scalar>{}, scene.observations, config, owned.workspace,
+                                    result);
+    counts = counter.stop();
+  }
+  EXPECT_NO_HEAP(counts, "estimate_deformability (final_equilibrium)");
+  ASSERT_EQ(status, Status::ok);
+  EXPECT_GT(result.evaluations, config.grid_points);
+  EXPECT_GE(result.msm_beta, 0.0);
+  EXPECT_LE(result.msm_beta, 1.0);
+  EXPECT_TRUE(std::isfinite(result.error));
+}
+
+TYPED_TEST(RealTimeAllocation, EstimateWithAlpha) {
+  using Scalar = typename TestFixture::FixtureScalar;
+  constexpr int Dim = TestFixture::kFixtureDim;
+  const auto& scene = this->scene_;
+  DeformabilityConfig config;
+  config.mode = FitMode::trajectory;
+  config.estimate_alpha = true;
+  typename TestFixture::OwnedWorkspace owned;
+  this->make_workspace(config, owned);
+  DeformabilityResult result;
+  Status status = Status::not_initialized;
+  AllocationCounts counts;
+  {
+    AllocationCounter counter;
+    status = estimate_deformability(scene.model, MsmParams<Dim, Scalar>{}, scene.observations, config, owned.workspace,
+                                    result);
+    counts = counter.stop();
+  }
+  EXPECT_NO_HEAP(counts, "estimate_deformability (estimate_alpha)");
+  ASSERT_EQ(status, Status::ok);
+  EXPECT_GE(result.msm_alpha, config.alpha_min);
+  EXPECT_LE(result.msm_alpha, 1.0);
+  EXPECT_TRUE(std::isfinite(result.msm_beta));
+  EXPECT_GT(result.evaluations, 5 * config.grid_points);
+}
+
+TYPED_TEST(RealTimeAllocation, EvaluateDeformabilityError) {
+  using Scalar = typename TestFixture::FixtureScalar;
+  constexpr int Dim = TestFixture::kFixtureDim;
+  const auto& scene = this->scene_;
+  DeformabilityConfig trajectory;
+  trajectory.mode = FitMode::trajectory;
+  DeformabilityConfig final_mode;
+  final_mode.mode = FitMode::final_equilibrium;
+  typename TestFixture::OwnedWorkspace owned;
+  this->make_workspace(trajectory, owned);
+  MsmParams<Dim, Scalar> truth;
+  truth.msm_beta = static_cast<Scalar>(Scene<Dim, Scalar>::kTruthBeta);
+  MsmParams<Dim, Scalar> wrong;
+  wrong.msm_beta = Scalar(1);
+  TrajectoryError at_truth, at_wrong, at_final;
+  Status s_truth = Status::not_initialized, s_wrong = Status::not_initialized, s_final = Status::not_initialized;
+  AllocationCounts counts;
+  {
+    AllocationCounter counter;
+    s_truth = evaluate_deformability_error(scene.model, truth, scene.observations, trajectory, owned.workspace, at_truth);
+    s_wrong = evaluate_deformability_error(scene.model, wrong, scene.observations, trajectory, owned.workspace, at_wrong);
+    msm_state_reset(scene.model, owned.workspace.state);
+    s_final = evaluate_deformability_error(scene.model, truth, scene.observations, final_mode, owned.workspace, at_final);
+    counts = counter.stop();
+  }
+  EXPECT_NO_HEAP(counts, "evaluate_deformability_error");
+  EXPECT_EQ(s_truth, Status::ok);
+  EXPECT_EQ(s_wrong, Status::ok);
+  EXPECT_EQ(s_final, Status::ok);
+  EXPECT_GT(at_truth.count, 0);
+  EXPECT_LT(at_truth.mean_distance, at_wrong.mean_distance);
+  EXPECT_TRUE(at_final.converged);
+}
+
+}  // namespace
+}  // namespace pliant

@@ -1,0 +1,74 @@
+// Online estimation frame by frame: converges to the offline answer on the same press.
+#include "pliant/core/online_deformability.hpp"
+
+#include <gtest/gtest.h>
+
+#include "press_observations.hpp"
+
+namespace {
+
+using pliant::Status;
+
+template <int Dim, typename Scalar>
+pliant::OnlineDeformabilityEstimate run_online(const pliant::test::PressExperiment<Dim, Scalar>& experiment,
+                                               const pliant::OnlineDeformabilityConfig& config) {
+  pliant::test::MsmFixture<Dim, Scalar> f(experiment.builder.config());
+  EXPECT_EQ(f.status, Status::ok);
+  std::vector<unsigned char> block(pliant::online_deformability_workspace_size(f.model, config));
+  pliant::Arena arena(block.data(), block.size());
+  pliant::OnlineDeformability<Dim, Scalar> online;
+  EXPECT_EQ(pliant::online_deformability_init(arena, f.model, pliant::MsmParams<Dim, Scalar>{}, config, online), Status::ok);
+  const auto obs = experiment.observations();
+  using Vec = Eigen::Matrix<Scalar, Dim, 1>;
+  std::vector<Vec> frame(static_cast<std::size_t>(obs.particle_count));
+  for (int k = 1; k < obs.frame_count; ++k) {
+    for (int i = 0; i < obs.particle_count; ++i) frame[static_cast<std::size_t>(i)] = obs.point(k, i);
+    const Vec target = obs.point(k, experiment.tool);
+    const pliant::MsmDrivenTargets<Dim, Scalar> driven{&experiment.tool, &target, 1};
+    EXPECT_EQ(pliant::online_deformability_update(f.model, online, static_cast<Scalar>(obs.times_s[k] - obs.times_s[k - 1]),
+                                                  driven, frame.data()),
+              Status::ok);
+  }
+  return pliant::online_deformability_estimate(online);
+}
+
+TEST(OnlineDeformability, ConvergesToTheTruthDuringThePress) {
+  for (double beta : {0.2, 0.55, 0.85}) {
+    pliant::test::PressExperiment<2, double> experiment(beta, 1.0, 0.5, 3);
+    const auto estimate = run_online(experiment, pliant::OnlineDeformabilityConfig{});
+    EXPECT_NEAR(estimate.msm_beta, beta, 0.03) << beta;
+    EXPECT_TRUE(estimate.unique_minimum);
+    EXPECT_LT(estimate.msm_beta_std, 0.05);
+    EXPECT_EQ(estimate.frames, experiment.times.size() - 1);
+  }
+}
+
+TEST(OnlineDeformability, ThreeDimensionalFloat) {
+  pliant::test::PressExperiment<3, float> experiment(0.35, 1.0, 0.0, 1, 5, 4, 3, 0.01, 0.004, 3.0);
+  const auto estimate = run_online(experiment, pliant::OnlineDeformabilityConfig{});
+  EXPECT_NEAR(estimate.msm_beta, 0.35, 0.03);
+}
+
+TEST(OnlineDeformability, NoEvidenceMeansNoConfidence) {
+  pliant::test::PressExperiment<2, double> experiment(0.5, 1.0, 0.0, 1);
+  pliant::test::MsmFixture<2, double> f(experiment.builder.config());
+  ASSERT_EQ(f.status, Status::ok);
+  pliant::OnlineDeformabilityConfig config;
+  std::vector<unsigned char> block(pliant::online_deformability_workspace_size(f.model, config));
+  pliant::Arena arena(block.data(), block.size());
+  pliant::OnlineDeformability<2, double> online;
+  ASSERT_EQ(pliant::online_deformability_init(arena, f.model, pliant::MsmParams<2, double>{}, config, online), Status::ok);
+  EXPECT_FALSE(std::isfinite(pliant::online_deformability_estimate(online).msm_beta_std));
+
+  std::vector<Eigen::Vector2d> hidden(32, Eigen::Vector2d::Constant(std::nan("")));
+  const pliant::MsmDrivenTargets<2, double> none{};
+  EXPECT_EQ(pliant::online_deformability_update(f.model, online, 1.0 / 30, none, hidden.data()), Status::no_observations);
+  EXPECT_EQ(online.empty_frames, 1u);
+  EXPECT_EQ(pliant::online_deformability_update(f.model, online, std::nan(""), none, hidden.data()), Status::invalid_argument);
+  EXPECT_EQ(online.rejected_frames, 1u);
+  pliant::OnlineDeformabilityConfig bad;
+  bad.candidates = 2;
+  EXPECT_EQ(pliant::online_deformability_init(arena, f.model, pliant::MsmParams<2, double>{}, bad, online), Status::invalid_argument);
+}
+
+}  // namespace
