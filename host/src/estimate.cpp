@@ -43,6 +43,7 @@ EstimateReport run(const Recording& recording, const EstimateOptions& options) {
   report.curve_beta.assign(workspace.curve_beta, workspace.curve_beta + report.result.curve_count);
   report.curve_error.assign(workspace.curve_error, workspace.curve_error + report.result.curve_count);
   report.cluster_count = model->model.cluster_count;
+  report.rest_frames = model->rest_frames;
   report.spacing = model->model.spacing;
   const int frames = recording.frame_count();
   report.frame_interval_s = frames > 1 ? (recording.frame_times_s.back() - recording.frame_times_s.front()) / (frames - 1) : 0.0;
@@ -93,6 +94,8 @@ nlohmann::json estimate_json(const Recording& recording, const EstimateOptions& 
                                                                                      : "grid_blocks"},
       {"cluster_radius_factor", options.setup.clusters.radius_factor},
       {"driven_mass_factor", options.setup.driven_mass_factor},
+      {"rest_source", options.setup.rest == RestSource::still_frames ? "still_frames" : "first_frame"},
+      {"rest_frames", report.rest_frames},
       {"msm_alpha_estimated", options.estimate_alpha && options.mode == FitMode::trajectory},
       {"gravity_declared", recording.gravity.has_value()},
   };

@@ -1,6 +1,7 @@
 #include "pliant/host/msm_setup.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -8,6 +9,59 @@ namespace pliant::host {
 
 void require_ok(Status status, const char* what) {
   if (status != Status::ok) throw std::runtime_error(std::string(what) + ": " + status_name(status));
+}
+
+StillRest rest_from_still_frames(const Recording& recording) {
+  StillRest out;
+  out.positions = recording.rest_positions;
+  const int n = recording.particle_count;
+  const int dim = recording.dimension;
+  const int frames = recording.frame_count();
+  if (recording.mesh || recording.fixed.empty() || frames < 3) return out;
+
+  std::vector<double> changes;
+  for (int k = 1; k < frames; ++k) {
+    for (int id : recording.fixed) {
+      if (!recording.observed(k, id) || !recording.observed(k - 1, id)) continue;
+      for (int d = 0; d < dim; ++d) changes.push_back(std::abs(recording.position(k, id, d) - recording.position(k - 1, id, d)));
+    }
+  }
+  if (changes.size() < 8) return out;
+  auto middle = changes.begin() + static_cast<std::ptrdiff_t>(changes.size() / 2);
+  std::nth_element(changes.begin(), middle, changes.end());
+  // Median |difference of two N(0, s^2)| = 0.6745 * sqrt(2) * s.
+  const double noise = *middle / (0.6745 * std::sqrt(2.0));
+  out.noise_std = noise;
+  if (!(noise > 0)) return out;
+
+  const double limit = 5.0 * std::sqrt(2.0) * noise;
+  int still = 1;
+  for (; still < frames; ++still) {
+    bool moved = false;
+    for (int i = 0; i < n && !moved; ++i) {
+      if (!recording.observed(still, i)) continue;
+      for (int d = 0; d < dim; ++d) {
+        if (std::abs(recording.position(still, i, d) - recording.position(0, i, d)) > limit) moved = true;
+      }
+    }
+    if (moved) break;
+  }
+  // The last still frame may already hold the first, sub-threshold part of the motion.
+  still = std::max(1, still - 1);
+  std::vector<double> count(static_cast<std::size_t>(n), 0.0);
+  std::fill(out.positions.begin(), out.positions.end(), 0.0);
+  for (int k = 0; k < still; ++k) {
+    for (int i = 0; i < n; ++i) {
+      if (!recording.observed(k, i)) continue;
+      count[static_cast<std::size_t>(i)] += 1.0;
+      for (int d = 0; d < dim; ++d) out.positions[static_cast<std::size_t>(i * dim + d)] += recording.position(k, i, d);
+    }
+  }
+  for (int i = 0; i < n; ++i) {
+    for (int d = 0; d < dim; ++d) out.positions[static_cast<std::size_t>(i * dim + d)] /= count[static_cast<std::size_t>(i)];
+  }
+  out.frames = still;
+  return out;
 }
 
 template <int Dim>
@@ -22,9 +76,16 @@ std::unique_ptr<HostMsmModel<Dim>> build_msm_model(const Recording& recording, c
     drivable.push_back(window.id);
     out->driven.push_back(window);
   }
+  StillRest rest;
+  if (options.rest == RestSource::still_frames) {
+    rest = rest_from_still_frames(recording);
+  } else {
+    rest.positions = recording.rest_positions;
+  }
+  out->rest_frames = rest.frames;
   MsmModelConfig<Dim, double> config;
   config.particle_count = n;
-  config.rest_positions = recording.rest_positions.data();
+  config.rest_positions = rest.positions.data();
   config.masses = recording.masses.empty() ? nullptr : recording.masses.data();
   config.fixed = fixed.data();
   config.drivable_ids = drivable.empty() ? nullptr : drivable.data();

@@ -28,7 +28,11 @@ struct ScenarioPlan {
   std::string object;
 };
 
-double ramp(double t, double ramp_s) { return std::clamp(t / ramp_s, 0.0, 1.0); }
+// Every scenario films the object still for this long before the tool starts to move, as a
+// robot camera does while the arm approaches.
+constexpr double kLeadIn_s = 0.5;
+
+double ramp(double t, double ramp_s) { return std::clamp((t - kLeadIn_s) / ramp_s, 0.0, 1.0); }
 
 ScenarioPlan foam_press() {
   ScenarioPlan plan;
@@ -46,7 +50,7 @@ ScenarioPlan foam_press() {
     }
   }
   plan.tool = 3 * cols + 4;
-  plan.duration_s = 4.0;
+  plan.duration_s = kLeadIn_s + 4.0;
   plan.rate_hz = 30.0;
   plan.tool_offset = [](double t) { return std::vector<double>{0.0, 60.0 * ramp(t, 1.0)}; };
   plan.object = "simulated foam block pressed by a tool, image plane";
@@ -72,7 +76,7 @@ ScenarioPlan block_press() {
     }
   }
   plan.tool = ((nz - 1) * ny + 2) * nx + 2;
-  plan.duration_s = 3.0;
+  plan.duration_s = kLeadIn_s + 3.0;
   plan.rate_hz = 30.0;
   plan.tool_offset = [](double t) { return std::vector<double>{0.0, 0.0, -0.006 * ramp(t, 1.0)}; };
   plan.object = "simulated 3D block pressed from above";
@@ -94,8 +98,8 @@ ScenarioPlan cantilever_strip() {
     }
   }
   plan.tool = 1 * cols + (cols - 1);
-  plan.release_s = 2.0;
-  plan.duration_s = 4.0;
+  plan.release_s = kLeadIn_s + 2.0;
+  plan.duration_s = kLeadIn_s + 4.0;
   plan.rate_hz = 60.0;
   plan.tool_offset = [](double t) { return std::vector<double>{0.0, -0.02 * ramp(t, 1.0)}; };
   plan.object = "simulated clamped strip, tip pulled down and released";

@@ -34,6 +34,7 @@ struct EstimateReport {
   std::vector<double> curve_beta;
   std::vector<double> curve_error;
   int cluster_count = 0;
+  int rest_frames = 1;             ///< leading still frames averaged into the rest shape
   double spacing = 0;              ///< median nearest-neighbour distance of the rest shape
   double frame_interval_s = 0;     ///< mean time step used by the simulation
   double runtime_s = 0;

@@ -5,6 +5,7 @@
 // Gaussian position noise. The truth goes into a separate truth.json document that no
 // estimator reads; the recording carries no hint of it.
 //
+// Every scenario starts with 0.5 s of the object at rest before the tool moves.
 // Scenarios
 // - foam_press: the optical-flow MSM paper's setup in the image plane (px): a 4 x 8 particle
 //   grid at 100 px spacing, bottom row (ids 0..7) fixed on the support, the top-row particle 28

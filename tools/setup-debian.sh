@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages pliant needs, skipping what is already installed.
+# Usage: bash tools/setup-debian.sh            (as root, or with sudo available)
+set -euo pipefail
+
+packages=(
+  cmake g++ make pkg-config      # build
+  libeigen3-dev                  # core linear algebra (the only core dependency)
+  nlohmann-json3-dev             # recording and result JSON (host)
+  libcli11-dev                   # the pliant command line
+  libgtest-dev                   # unit tests
+  libbenchmark-dev               # bench/
+  clang libclang-rt-14-dev       # libFuzzer targets and their sanitizer runtimes
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup: all ${#packages[@]} packages present"
+  exit 0
+fi
+as_root=()
+if [ "$(id -u)" -ne 0 ]; then as_root=(sudo); fi
+echo "setup: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+"${as_root[@]}" apt-get update -qq
+"${as_root[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
