@@ -1,8 +1,11 @@
 #include "pliant/host/estimate.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <random>
+#include <vector>
 #include <stdexcept>
 
 namespace pliant::host {
@@ -18,6 +21,71 @@ std::string explain(Status status) {
 }
 
 template <int Dim>
+EstimateReport run(const Recording& recording, const EstimateOptions& options);
+
+// Progress over several estimator runs: run `stage` of `stages` maps onto one overall bar.
+struct StagedProgress {
+  ProgressCallback callback = nullptr;
+  void* context = nullptr;
+  int stage = 0;
+  int stages = 1;
+  static void forward(void* self, int done, int total) {
+    const auto* p = static_cast<const StagedProgress*>(self);
+    p->callback(p->context, p->stage * total + done, p->stages * total);
+  }
+};
+
+// Spread of msm_beta when the inputs the model is built on (rest shape, driven tracks) are
+// perturbed by the measured noise: a parametric bootstrap of the input-noise contribution.
+template <int Dim>
+double input_noise_std(const Recording& recording, const EstimateOptions& options, const HostMsmModel<Dim>& base,
+                       double noise_std) {
+  if (options.input_noise_samples < 2 || !(noise_std > 0)) return 0.0;
+  EstimateOptions refit = options;
+  refit.input_noise_samples = 0;
+  refit.grid_points = 6;
+  refit.tolerance = 2e-3;
+  refit.estimate_alpha = false;
+  refit.setup.rest = RestSource::first_frame;
+  StagedProgress staged{options.progress, options.progress_context, 0, options.input_noise_samples + 1};
+  if (options.progress != nullptr) {
+    refit.progress = &StagedProgress::forward;
+    refit.progress_context = &staged;
+  }
+  std::mt19937_64 rng(0x5eed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  const double rest_sigma = noise_std / std::sqrt(static_cast<double>(base.rest_frames));
+  std::vector<double> betas;
+  for (int sample = 0; sample < options.input_noise_samples; ++sample) {
+    staged.stage = sample + 1;
+    Recording perturbed = recording;
+    perturbed.rest_positions = base.rest;
+    for (double& x : perturbed.rest_positions) x += rest_sigma * normal(rng);
+    for (const DrivenWindow& window : base.driven) {
+      for (int k = 0; k < perturbed.frame_count(); ++k) {
+        if (!window.active_at(perturbed.frame_times_s[static_cast<std::size_t>(k)]) || !perturbed.observed(k, window.id)) continue;
+        for (int d = 0; d < Dim; ++d) {
+          perturbed.positions[(static_cast<std::size_t>(k) * static_cast<std::size_t>(perturbed.particle_count) +
+                               static_cast<std::size_t>(window.id)) * Dim + static_cast<std::size_t>(d)] += noise_std * normal(rng);
+        }
+      }
+    }
+    try {
+      betas.push_back(run<Dim>(perturbed, refit).result.msm_beta);
+    } catch (const std::runtime_error&) {
+      // A perturbed refit that cannot run says nothing about the spread; skip it.
+    }
+  }
+  if (betas.size() < 2) return 0.0;
+  double mean = 0;
+  for (double b : betas) mean += b;
+  mean /= static_cast<double>(betas.size());
+  double squares = 0;
+  for (double b : betas) squares += (b - mean) * (b - mean);
+  return std::sqrt(squares / static_cast<double>(betas.size() - 1));
+}
+
+template <int Dim>
 EstimateReport run(const Recording& recording, const EstimateOptions& options) {
   const auto started = std::chrono::steady_clock::now();
   auto model = build_msm_model<Dim>(recording, options.setup);
@@ -26,8 +94,14 @@ EstimateReport run(const Recording& recording, const EstimateOptions& options) {
   config.estimate_alpha = options.estimate_alpha;
   config.grid_points = options.grid_points;
   config.tolerance = options.tolerance;
-  config.progress = options.progress;
-  config.progress_context = options.progress_context;
+  StagedProgress staged{options.progress, options.progress_context, 0, std::max(1, options.input_noise_samples + 1)};
+  if (options.progress != nullptr && options.input_noise_samples >= 2) {
+    config.progress = &StagedProgress::forward;
+    config.progress_context = &staged;
+  } else {
+    config.progress = options.progress;
+    config.progress_context = options.progress_context;
+  }
   const int driven = static_cast<int>(model->driven.size());
   const std::size_t bytes = deformability_workspace_size(model->model, driven, config);
   auto block = std::make_unique<unsigned char[]>(bytes);
@@ -47,6 +121,11 @@ EstimateReport run(const Recording& recording, const EstimateOptions& options) {
   report.spacing = model->model.spacing;
   const int frames = recording.frame_count();
   report.frame_interval_s = frames > 1 ? (recording.frame_times_s.back() - recording.frame_times_s.front()) / (frames - 1) : 0.0;
+  // Without fixed particles to measure noise on, the fit's residual is a conservative stand-in.
+  report.noise_std = model->noise_std > 0 ? model->noise_std : report.result.rms;
+  report.msm_beta_std_curvature = report.result.msm_beta_std;
+  report.msm_beta_std_input = input_noise_std<Dim>(recording, options, *model, report.noise_std);
+  report.msm_beta_std = std::hypot(report.msm_beta_std_curvature, report.msm_beta_std_input);
   report.runtime_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return report;
 }
@@ -71,7 +150,7 @@ FitMode parse_fit_mode(const std::string& name) {
 
 nlohmann::json estimate_json(const Recording& recording, const EstimateOptions& options, const EstimateReport& report) {
   const DeformabilityResult& r = report.result;
-  nlohmann::json uncertainty = {{"msm_beta", finite_or(r.msm_beta_std, 1.0)}};
+  nlohmann::json uncertainty = {{"msm_beta", finite_or(report.msm_beta_std, 1.0)}};
   nlohmann::json out = {
       {"format", "pliant-estimate"},
       {"version", 1},
@@ -106,6 +185,10 @@ nlohmann::json estimate_json(const Recording& recording, const EstimateOptions& 
       {"frames_without_observations", r.frames_without_observations},
       {"unconverged_equilibria", r.unconverged_equilibria},
       {"spacing", report.spacing},
+      {"noise_std", report.noise_std},
+      {"msm_beta_std_curvature", finite_or(report.msm_beta_std_curvature, 1.0)},
+      {"msm_beta_std_input_noise", report.msm_beta_std_input},
+      {"input_noise_samples", options.input_noise_samples},
       {"runtime_s", report.runtime_s},
   };
   if (!std::isfinite(r.msm_beta_std)) out["diagnostics"]["msm_beta_identifiable"] = false;

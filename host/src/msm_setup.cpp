@@ -76,13 +76,15 @@ std::unique_ptr<HostMsmModel<Dim>> build_msm_model(const Recording& recording, c
     drivable.push_back(window.id);
     out->driven.push_back(window);
   }
-  StillRest rest;
-  if (options.rest == RestSource::still_frames) {
-    rest = rest_from_still_frames(recording);
-  } else {
+  // The noise measurement is wanted even when frame 0 is the rest shape.
+  StillRest rest = rest_from_still_frames(recording);
+  if (options.rest == RestSource::first_frame) {
     rest.positions = recording.rest_positions;
+    rest.frames = 1;
   }
   out->rest_frames = rest.frames;
+  out->rest = rest.positions;
+  out->noise_std = rest.noise_std;
   MsmModelConfig<Dim, double> config;
   config.particle_count = n;
   config.rest_positions = rest.positions.data();

@@ -56,6 +56,17 @@ TEST(EstimateAccuracy, FoamPressAcrossNoiseSeeds) {
   }
 }
 
+TEST(EstimateAccuracy, ReportedUncertaintyCoversTheError) {
+  int covered = 0;
+  for (std::uint64_t seed = 21; seed <= 30; ++seed) {
+    const auto report = estimate("foam_press", 0.35, seed);
+    EXPECT_LT(report.msm_beta_std, 0.02);  // informative
+    EXPECT_GT(report.msm_beta_std_input, 0.0);
+    if (std::abs(report.result.msm_beta - 0.35) <= 2 * report.msm_beta_std) ++covered;
+  }
+  EXPECT_GE(covered, 9);
+}
+
 TEST(EstimateAccuracy, FinalEquilibriumModeIsCoarserButClose) {
   // The paper's final-state error uses one frame, so noise matters more than over a trajectory.
   for (double beta : {0.2, 0.6}) {

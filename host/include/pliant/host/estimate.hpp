@@ -25,6 +25,10 @@ struct EstimateOptions {
   int grid_points = 11;
   double tolerance = 1e-3;
   MsmSetupOptions setup;
+  /// Refits with the rest shape and the tool track perturbed by the measured position noise,
+  /// this many times; their spread is the part of the uncertainty that input noise causes
+  /// (the curvature of the error curve only sees noise on the compared particles). 0: off.
+  int input_noise_samples = 8;
   ProgressCallback progress = nullptr;  ///< forwarded to DeformabilityConfig; must not block
   void* progress_context = nullptr;
 };
@@ -35,6 +39,10 @@ struct EstimateReport {
   std::vector<double> curve_error;
   int cluster_count = 0;
   int rest_frames = 1;             ///< leading still frames averaged into the rest shape
+  double noise_std = 0;            ///< position noise used for the input perturbation
+  double msm_beta_std_curvature = 0;   ///< from the error curve alone (core estimator)
+  double msm_beta_std_input = 0;       ///< spread of refits under perturbed inputs
+  double msm_beta_std = 0;             ///< combined: sqrt(curvature^2 + input^2)
   double spacing = 0;              ///< median nearest-neighbour distance of the rest shape
   double frame_interval_s = 0;     ///< mean time step used by the simulation
   double runtime_s = 0;

@@ -52,6 +52,8 @@ struct HostMsmModel {
   MsmModel<Dim, double> model;
   std::vector<DrivenWindow> driven;  ///< the recording's driven windows
   int rest_frames = 1;               ///< frames averaged into the rest shape
+  std::vector<double> rest;          ///< the rest shape used, particle_count * Dim
+  double noise_std = 0;              ///< position noise measured on fixed particles (0: unknown)
 };
 
 /// Builds the model. With RestSource::still_frames the rest shape is rest_from_still_frames().

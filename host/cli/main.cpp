@@ -1,0 +1,57 @@
+// pliant command line: parses the arguments and hands over to one command.
+#include <iostream>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "command_estimate.hpp"
+#include "command_simulate.hpp"
+#include "exit_status.hpp"
+
+namespace pliant::cli {
+namespace {
+
+// CLI11 reports parse errors in its own words; keep them, but as one line under our prefix.
+int report_parse_error(const CLI::App& app, const CLI::ParseError& error) {
+  const std::vector<CLI::App*> commands = app.get_subcommands();
+  if (commands.empty()) {
+    const std::vector<std::string> rest = app.remaining();
+    if (!rest.empty() && rest.front().rfind('-', 0) != 0) {
+      report_error("pliant", "unknown command '" + rest.front() + "'; see 'pliant --help'");
+      return exit_usage;
+    }
+    report_error("pliant", std::string(error.what()) + "; see 'pliant --help'");
+    return exit_usage;
+  }
+  const std::string name = "pliant " + commands.front()->get_name();
+  report_error(name, std::string(error.what()) + "; see '" + name + " --help'");
+  return exit_usage;
+}
+
+int run(int argc, char** argv) {
+  CLI::App app{"pliant: deformability (msm_beta) of soft objects from recorded trajectories", "pliant"};
+  app.set_version_flag("--version", std::string("pliant ") + PLIANT_VERSION);
+  app.footer(
+      "Run 'pliant COMMAND --help' for the options of a command.\n"
+      "Exit status: 0 success, 1 runtime failure, 2 usage error or malformed recording.");
+  EstimateCommand estimate(app);
+  SimulateCommand simulate(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success& done) {  // --help, --version
+    return app.exit(done);
+  } catch (const CLI::ParseError& error) {
+    return report_parse_error(app, error);
+  }
+  if (estimate.selected()) return run_reporting_errors("pliant estimate", [&] { return estimate.run(); });
+  if (simulate.selected()) return run_reporting_errors("pliant simulate", [&] { return simulate.run(); });
+  std::cerr << app.help();
+  return exit_usage;
+}
+
+}  // namespace
+}  // namespace pliant::cli
+
+int main(int argc, char** argv) {
+  return pliant::cli::run_reporting_errors("pliant", [&] { return pliant::cli::run(argc, argv); });
+}

@@ -1,0 +1,96 @@
+// Help, version and usage errors: exit statuses and one-line messages.
+#include <gtest/gtest.h>
+
+#include "cli_test_support.hpp"
+#include "pliant/host/scenarios.hpp"
+
+namespace pliant::cli_test {
+namespace {
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+TEST(cli_usage, HelpListsCommandsAndExitsZero) {
+  const CommandResult r = run_pliant("--help");
+  EXPECT_EQ(r.status, 0);
+  EXPECT_TRUE(contains(r.out, "Usage: pliant")) << r.out;
+  EXPECT_TRUE(contains(r.out, "estimate")) << r.out;
+  EXPECT_TRUE(contains(r.out, "simulate")) << r.out;
+  EXPECT_EQ(r.err, "");
+}
+
+TEST(cli_usage, VersionIsTheProjectVersion) {
+  const CommandResult r = run_pliant("--version");
+  EXPECT_EQ(r.status, 0);
+  EXPECT_EQ(r.out, std::string("pliant ") + PLIANT_VERSION + "\n");
+}
+
+TEST(cli_usage, NoCommandPrintsHelpAndExitsTwo) {
+  const CommandResult r = run_pliant("");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(contains(r.err, "Usage: pliant")) << r.err;
+  EXPECT_EQ(r.out, "");
+}
+
+TEST(cli_usage, UnknownCommandIsOneLineAndExitsTwo) {
+  const CommandResult r = run_pliant("frobnicate");
+  EXPECT_EQ(r.status, 2);
+  ASSERT_EQ(r.err_lines().size(), 1u) << r.err;
+  EXPECT_TRUE(contains(r.err, "pliant: ")) << r.err;
+  EXPECT_TRUE(contains(r.err, "unknown command 'frobnicate'")) << r.err;
+}
+
+TEST(cli_usage, UnknownOptionIsOneLineAndExitsTwo) {
+  const CommandResult r = run_pliant("--frobnicate");
+  EXPECT_EQ(r.status, 2);
+  ASSERT_EQ(r.err_lines().size(), 1u) << r.err;
+  EXPECT_TRUE(contains(r.err, "--frobnicate")) << r.err;
+}
+
+TEST(cli_usage, CommandHelpShowsItsOptions) {
+  const CommandResult estimate = run_pliant("estimate --help");
+  EXPECT_EQ(estimate.status, 0);
+  for (const char* option : {"--json", "--mode", "--alpha", "--msm-alpha", "--grid", "--quiet"}) {
+    EXPECT_TRUE(contains(estimate.out, option)) << option;
+  }
+  const CommandResult simulate = run_pliant("simulate --help");
+  EXPECT_EQ(simulate.status, 0);
+  for (const char* option : {"--output", "--beta", "--alpha", "--noise", "--seed", "--rate", "--force"}) {
+    EXPECT_TRUE(contains(simulate.out, option)) << option;
+  }
+  for (const std::string& name : host::scenario_names()) EXPECT_TRUE(contains(simulate.out, name)) << name;
+}
+
+TEST(cli_usage, MissingRecordingArgumentExitsTwo) {
+  const CommandResult r = run_pliant("estimate");
+  EXPECT_EQ(r.status, 2);
+  ASSERT_EQ(r.err_lines().size(), 1u) << r.err;
+  EXPECT_TRUE(contains(r.err, "pliant estimate: ")) << r.err;
+  EXPECT_TRUE(contains(r.err, "REC")) << r.err;
+}
+
+struct BadOption {
+  std::string arguments;  // after `estimate REC`
+  std::string mentions;
+};
+
+TEST(cli_usage, BadEstimateOptionValuesExitTwoWithOneLine) {
+  TempDir dir;
+  write_tiny_recording(dir / "rec");
+  const std::vector<BadOption> cases = {
+      {"--mode sideways", "--mode"},       {"--grid 2", "--grid"},
+      {"--grid many", "--grid"},           {"--msm-alpha 0", "--msm-alpha"},
+      {"--msm-alpha 1.5", "--msm-alpha"},  {"--alpha --mode final", "--alpha"},
+      {"--alpha --msm-alpha 0.5", "--alpha"},
+  };
+  for (const BadOption& c : cases) {
+    const CommandResult r = run_pliant("estimate " + quoted(dir / "rec") + " " + c.arguments);
+    EXPECT_EQ(r.status, 2) << c.arguments;
+    ASSERT_EQ(r.err_lines().size(), 1u) << c.arguments << ": " << r.err;
+    EXPECT_EQ(r.err.rfind("pliant estimate: ", 0), 0u) << r.err;
+    EXPECT_TRUE(contains(r.err, c.mentions)) << c.arguments << ": " << r.err;
+    EXPECT_EQ(r.out, "") << c.arguments;
+  }
+}
+
+}  // namespace
+}  // namespace pliant::cli_test
