@@ -159,9 +159,17 @@ Status msm_step(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>
   for (int k = 0; k < input.driven.count; ++k) {
     const int id = input.driven.ids[k];
     const Vec& target = input.driven.positions[k];
-    if (id < 0 || id >= n || model.drivable[id] == 0 || model.fixed[id] != 0 || !target.allFinite()) {
+    if (id < 0 || id >= n || model.drivable[id] == 0 || model.fixed[id] != 0) {
       ++state.dropped_targets;
       result = Status::non_finite_input;
+      continue;
+    }
+    if (!target.allFinite()) {
+      // Fail safe: the contact particle holds where it was rather than falling free.
+      ++state.dropped_targets;
+      result = Status::non_finite_input;
+      state.predicted[id] = state.position[id];
+      state.driven_now[id] = 1;
       continue;
     }
     state.predicted[id] = target;

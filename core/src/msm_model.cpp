@@ -276,11 +276,15 @@ Status build(Arena& arena, const MsmModelConfig<Dim, Scalar>& config, MsmModel<D
       m.member_rest_offset[k] = q.template cast<Scalar>();
     }
     // Pseudo-inverse: collinear (2D) or flat (3D) clusters have a rank-deficient A_qq; the
-    // affine fit then acts only inside the cluster's span, which is all its goals need.
+    // affine fit then acts only inside the cluster's span, which is all its goals need. A
+    // direction whose extent is under ~3 % of the cluster's (variance ratio 1e-3) is treated as
+    // absent: in a nearly flat cluster it holds only measurement noise, which inverting would
+    // amplify into a spurious stretch.
+    constexpr double kFlatVarianceRatio = 1e-3;
     Eigen::SelfAdjointEigenSolver<MatD> eigen;
     eigen.computeDirect(aqq);
     const VecD lambda = eigen.eigenvalues();
-    const double threshold = lambda.cwiseAbs().maxCoeff() * 1e-9;
+    const double threshold = lambda.cwiseAbs().maxCoeff() * kFlatVarianceRatio;
     VecD inverse_lambda;
     for (int d = 0; d < Dim; ++d) inverse_lambda(d) = lambda(d) > threshold ? 1.0 / lambda(d) : 0.0;
     const MatD aqq_inverse = eigen.eigenvectors() * inverse_lambda.asDiagonal() * eigen.eigenvectors().transpose();

@@ -13,7 +13,7 @@ bool extract_rotation(const Eigen::Matrix<Scalar, 2, 2>& a, Eigen::Matrix<Scalar
   // trace(R^T A) = c (a00 + a11) + s (a10 - a01): maximised by the angle of that vector.
   const Scalar cos_part = a(0, 0) + a(1, 1);
   const Scalar sin_part = a(1, 0) - a(0, 1);
-  const Scalar norm = std::hypot(cos_part, sin_part);
+  const Scalar norm = std::sqrt(cos_part * cos_part + sin_part * sin_part);
   const Scalar scale = a.cwiseAbs().maxCoeff();
   if (!(norm > std::numeric_limits<Scalar>::epsilon() * scale) || norm == Scalar(0)) {
     return true;  // no rotational information: keep the previous rotation

@@ -6,7 +6,8 @@
 // any heap use by the core -- including Eigen code compiled into pliant::core -- is counted
 // while an AllocationCounter is armed. Everything the calls need (model, states, workspaces,
 // observations, targets, result storage) is built before arming; gtest assertions run only
-// after disarming (a failing assertion allocates its message).
+// after disarming (a failing assertion allocates its message). Under valgrind's memcheck, which
+// replaces the allocator itself, the tests fail in SetUp instead of passing vacuously.
 //
 // Eigen: this translation unit is compiled with EIGEN_RUNTIME_NO_MALLOC (see allocation.cmake)
 // and the counter calls Eigen::internal::set_is_malloc_allowed(false) while armed, so a
@@ -17,9 +18,11 @@
 // the malloc interposition above still catches the allocation inside the core, because
 // Eigen's aligned_malloc ends in std::malloc.
 //
-// Defining EIGEN_RUNTIME_NO_MALLOC in one TU and not another changes only Eigen's
-// check_that_malloc_is_allowed(), which the fixed-size code paths shared with the core never
-// call.
+// Defining EIGEN_RUNTIME_NO_MALLOC (and the counting eigen_assert of counting_allocator.hpp)
+// in this TU and not in the core's changes only whether Eigen's inline functions check their
+// assertions; where the linker merges an inline function instantiated in both, either copy
+// computes the same result. The fixed-size code paths shared with the core never call
+// check_that_malloc_is_allowed().
 #include "support/counting_allocator.hpp"  // first: configures eigen_assert before any Eigen header
 
 #ifndef EIGEN_RUNTIME_NO_MALLOC
@@ -30,8 +33,11 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <limits>
+#include <new>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "pliant/core/deformability.hpp"
@@ -53,6 +59,20 @@ std::string describe(const AllocationCounts& c) {
   if (c.eigen_expression != nullptr) text += std::string(" (first: ") + c.eigen_expression + ")";
   if (!test::malloc_interposed()) text += " [malloc not interposed in this build]";
   return text;
+}
+
+// True when an armed counter sees a plain `new`. False when something else owns the allocator
+// (e.g. valgrind's memcheck replaces operator new and malloc): a zero count would then prove
+// nothing, so every real-time test below checks this first.
+bool counter_sees_new() {
+  AllocationCounts counts;
+  {
+    AllocationCounter counter;
+    int* volatile probe = new int(3);  // volatile: the allocation cannot be elided
+    delete probe;
+    counts = counter.stop();
+  }
+  return counts.news == 1 && counts.deletes == 1;
 }
 
 #define EXPECT_NO_HEAP(counts, what) EXPECT_EQ((counts).total(), 0u) << (what) << ": " << describe(counts)
@@ -337,7 +357,10 @@ class RealTimeAllocation : public ::testing::Test {
   using FixtureScalar = typename C::Scalar;
   using FixtureVec = Eigen::Matrix<FixtureScalar, kFixtureDim, 1>;
 
-  void SetUp() override { ASSERT_EQ(scene_.build(), Status::ok); }
+  void SetUp() override {
+    ASSERT_TRUE(counter_sees_new()) << "the counting allocator is not in effect (running under valgrind?)";
+    ASSERT_EQ(scene_.build(), Status::ok);
+  }
 
   // A state in its own block.
   struct OwnedState {

@@ -195,9 +195,11 @@ TYPED_TEST(MsmStep, NonFiniteTargetIsDroppedAndCounted) {
   pliant::MsmStepInput<T::FDim, typename T::Scalar> in;
   in.dt = typename T::Scalar(0.01);
   in.driven = {&id, &target, 1};
+  const Vec before = f.state.position[7];
   EXPECT_EQ(pliant::msm_step(f.model, p, in, f.state), Status::non_finite_input);
   EXPECT_EQ(f.state.dropped_targets, 1u);
   for (int i = 0; i < f.model.particle_count; ++i) EXPECT_TRUE(f.state.position[i].allFinite());
+  EXPECT_EQ(f.state.position[7], before);  // fail safe: the contact holds where it was
 
   const int not_drivable = 3;
   target = f.model.rest[3];

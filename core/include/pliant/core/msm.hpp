@@ -14,7 +14,8 @@
 // Real-time contract: msm_step and msm_state_reset are O(memberships + clusters), allocate
 // nothing, throw nothing. Non-finite inputs never reach the state: a NaN target is dropped
 // (counted in dropped_targets, the particle holds its previous position) and a bad dt or force
-// rejects the whole step (counted in rejected_steps, state unchanged).
+// rejects the whole step (counted in rejected_steps, state unchanged). A target for a particle
+// that is not drivable (or is fixed) is dropped and counted; that particle moves freely.
 #pragma once
 
 #include <cstddef>
