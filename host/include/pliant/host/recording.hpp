@@ -120,7 +120,9 @@ void finalize_recording(Recording& recording);
 
 /// Writes `recording` as a v1 directory (created if needed; existing files replaced).
 /// Writes to temporary names and renames, so a crash never leaves a half-written
-/// recording.json beside complete data. Throws std::runtime_error on I/O failure.
+/// recording.json beside complete data. Media named in `files` (video, .oni) are listed as given
+/// but not copied: the caller puts them in the directory. Throws std::runtime_error on I/O
+/// failure, on absolute or escaping paths, and on two roles sharing one file name.
 void write_recording(const Recording& recording, const std::string& directory);
 
 }  // namespace pliant::host
