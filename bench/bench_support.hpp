@@ -428,4 +428,28 @@ class CpuStopwatch {
   double total_ = 0;
 };
 
+// A simulated press and the model fitted to it, built once per key and cached for the run.
+template <int Dim, typename Scalar>
+struct PressScene {
+  PressRecording<Dim, Scalar> recording;
+  std::unique_ptr<OwnedModel<Dim, Scalar>> model;
+  Status status = Status::not_initialized;
+
+  explicit PressScene(const PressPlan& plan) {
+    simulate_press(plan, recording);
+    status = recording.status;
+    if (status != Status::ok) return;
+    model = std::make_unique<OwnedModel<Dim, Scalar>>(recording.rest, recording.fixed, recording.drivable);
+    status = model->status;
+  }
+};
+
+template <int Dim, typename Scalar>
+const PressScene<Dim, Scalar>& scene_for(const PressPlan& plan, const char* key) {
+  static std::map<std::string, std::unique_ptr<PressScene<Dim, Scalar>>> cache;
+  auto& slot = cache[key];
+  if (!slot) slot = std::make_unique<PressScene<Dim, Scalar>>(plan);
+  return *slot;
+}
+
 }  // namespace pliant::bench

@@ -17,30 +17,7 @@ namespace pliant::bench {
 namespace {
 
 template <int Dim, typename Scalar>
-struct EstimateScene {
-  PressRecording<Dim, Scalar> recording;
-  std::unique_ptr<OwnedModel<Dim, Scalar>> model;
-  Status status = Status::not_initialized;
-
-  explicit EstimateScene(const PressPlan& plan) {
-    simulate_press(plan, recording);
-    status = recording.status;
-    if (status != Status::ok) return;
-    model = std::make_unique<OwnedModel<Dim, Scalar>>(recording.rest, recording.fixed, recording.drivable);
-    status = model->status;
-  }
-};
-
-template <int Dim, typename Scalar>
-const EstimateScene<Dim, Scalar>& scene_for(const PressPlan& plan, const char* key) {
-  static std::map<std::string, std::unique_ptr<EstimateScene<Dim, Scalar>>> cache;
-  auto& slot = cache[key];
-  if (!slot) slot = std::make_unique<EstimateScene<Dim, Scalar>>(plan);
-  return *slot;
-}
-
-template <int Dim, typename Scalar>
-void run_estimate(benchmark::State& bench, const EstimateScene<Dim, Scalar>& scene, const DeformabilityConfig& config,
+void run_estimate(benchmark::State& bench, const PressScene<Dim, Scalar>& scene, const DeformabilityConfig& config,
                   double truth_beta) {
   if (scene.status != Status::ok) {
     bench.SkipWithError((std::string("scene setup failed: ") + status_name(scene.status)).c_str());
@@ -83,7 +60,7 @@ void run_estimate(benchmark::State& bench, const EstimateScene<Dim, Scalar>& sce
 template <int Dim, typename Scalar>
 void BM_Estimate(benchmark::State& bench, const char* scene_name, FitMode mode, bool estimate_alpha) {
   const PressPlan plan = Dim == 2 ? foam_press_plan() : block_press_plan();
-  const EstimateScene<Dim, Scalar>& scene = scene_for<Dim, Scalar>(plan, scene_name);
+  const PressScene<Dim, Scalar>& scene = scene_for<Dim, Scalar>(plan, scene_name);
   DeformabilityConfig config;
   config.mode = mode;
   config.estimate_alpha = estimate_alpha;

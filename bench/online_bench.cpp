@@ -20,29 +20,6 @@ namespace {
 
 constexpr int kCandidates = 11;
 
-template <int Dim, typename Scalar>
-struct OnlineScene {
-  PressRecording<Dim, Scalar> recording;
-  std::unique_ptr<OwnedModel<Dim, Scalar>> model;
-  Status status = Status::not_initialized;
-
-  explicit OnlineScene(const PressPlan& plan) {
-    simulate_press(plan, recording);
-    status = recording.status;
-    if (status != Status::ok) return;
-    model = std::make_unique<OwnedModel<Dim, Scalar>>(recording.rest, recording.fixed, recording.drivable);
-    status = model->status;
-  }
-};
-
-template <int Dim, typename Scalar>
-const OnlineScene<Dim, Scalar>& scene_for(const PressPlan& plan, const char* key) {
-  static std::map<std::string, std::unique_ptr<OnlineScene<Dim, Scalar>>> cache;
-  auto& slot = cache[key];
-  if (!slot) slot = std::make_unique<OnlineScene<Dim, Scalar>>(plan);
-  return *slot;
-}
-
 PressPlan plan_named(const std::string& name) {
   if (name == "foam_press") return foam_press_plan();
   if (name == "foam_press_3d") return foam_press_3d_plan();
@@ -52,7 +29,7 @@ PressPlan plan_named(const std::string& name) {
 template <int Dim, typename Scalar>
 void BM_OnlineUpdate(benchmark::State& bench, const char* scene_name) {
   const PressPlan plan = plan_named(scene_name);
-  const OnlineScene<Dim, Scalar>& scene = scene_for<Dim, Scalar>(plan, scene_name);
+  const PressScene<Dim, Scalar>& scene = scene_for<Dim, Scalar>(plan, scene_name);
   if (scene.status != Status::ok) {
     bench.SkipWithError((std::string("scene setup failed: ") + status_name(scene.status)).c_str());
     return;
@@ -112,7 +89,7 @@ void BM_OnlineUpdate(benchmark::State& bench, const char* scene_name) {
 template <int Dim, typename Scalar>
 void BM_OnlineEstimate(benchmark::State& bench, const char* scene_name) {
   const PressPlan plan = plan_named(scene_name);
-  const OnlineScene<Dim, Scalar>& scene = scene_for<Dim, Scalar>(plan, scene_name);
+  const PressScene<Dim, Scalar>& scene = scene_for<Dim, Scalar>(plan, scene_name);
   if (scene.status != Status::ok) {
     bench.SkipWithError("scene setup failed");
     return;

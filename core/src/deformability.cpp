@@ -185,6 +185,38 @@ int planned_search_evaluations(const DeformabilityConfig& config) noexcept {
   return config.grid_points + std::min(golden, config.max_refinements) + 3;
 }
 
+struct Minimum {
+  double x = 0;
+  double value = 0;
+};
+
+// Golden-section search for the minimum of f on [lo, hi]: stops when the bracket is narrower
+// than `tolerance` or after `max_evaluations` calls of f (at least two).
+template <typename F>
+Minimum golden_section_minimum(F&& f, double lo, double hi, double tolerance, int max_evaluations) noexcept {
+  const double ratio = 0.5 * (std::sqrt(5.0) - 1.0);
+  double a = hi - ratio * (hi - lo);
+  double b = lo + ratio * (hi - lo);
+  double fa = f(a);
+  double fb = f(b);
+  for (int evaluations = 2; evaluations < max_evaluations && hi - lo > tolerance; ++evaluations) {
+    if (fa <= fb) {
+      hi = b;
+      b = a;
+      fb = fa;
+      a = hi - ratio * (hi - lo);
+      fa = f(a);
+    } else {
+      lo = a;
+      a = b;
+      fa = fb;
+      b = lo + ratio * (hi - lo);
+      fb = f(b);
+    }
+  }
+  return fa <= fb ? Minimum{a, fa} : Minimum{b, fb};
+}
+
 struct Progress {
   const DeformabilityConfig* config = nullptr;
   int done = 0;
@@ -248,26 +280,8 @@ Status search_beta(const MsmModel<Dim, Scalar>& model, MsmParams<Dim, Scalar> pa
   const double step = 1.0 / (grid - 1);
   double lo = std::max(0.0, (best_grid - 1) * step);
   double hi = std::min(1.0, (best_grid + 1) * step);
-  const double ratio = 0.5 * (std::sqrt(5.0) - 1.0);
-  double a = hi - ratio * (hi - lo);
-  double b = lo + ratio * (hi - lo);
-  double fa = evaluate(a).mean_distance;
-  double fb = evaluate(b).mean_distance;
-  for (int r = 2; r < config.max_refinements && hi - lo > config.tolerance; ++r) {
-    if (fa <= fb) {
-      hi = b;
-      b = a;
-      fb = fa;
-      a = hi - ratio * (hi - lo);
-      fa = evaluate(a).mean_distance;
-    } else {
-      lo = a;
-      a = b;
-      fa = fb;
-      b = lo + ratio * (hi - lo);
-      fb = evaluate(b).mean_distance;
-    }
-  }
+  (void)golden_section_minimum([&](double beta) { return evaluate(beta).mean_distance; }, lo, hi, config.tolerance,
+                               config.max_refinements);
 
   // Uncertainty from the curvature of the sum of squares around the estimate.
   const double h = std::max(0.01, 2.0 * config.tolerance);
@@ -415,20 +429,8 @@ Status estimate_deformability(const MsmModel<Dim, Scalar>& model, const MsmParam
   }
   double lo = config.alpha_min + span * std::max(0, best_index - 1) / (kAlphaGrid - 1);
   double hi = config.alpha_min + span * std::min(kAlphaGrid - 1, best_index + 1) / (kAlphaGrid - 1);
-  const double ratio = 0.5 * (std::sqrt(5.0) - 1.0);
-  double a = hi - ratio * (hi - lo);
-  double b = lo + ratio * (hi - lo);
-  double fa = profile(a);
-  double fb = profile(b);
-  for (int r = 0; r < 12 && hi - lo > 5e-3; ++r) {
-    if (fa <= fb) {
-      hi = b; b = a; fb = fa; a = hi - ratio * (hi - lo); fa = profile(a);
-    } else {
-      lo = a; a = b; fa = fb; b = lo + ratio * (hi - lo); fb = profile(b);
-    }
-  }
-  const double candidate = fa <= fb ? a : b;
-  if (std::min(fa, fb) < best_value) best_alpha = candidate;
+  const Minimum refined = golden_section_minimum(profile, lo, hi, 5e-3, 14);
+  if (refined.value < best_value) best_alpha = refined.x;
   params.msm_alpha = static_cast<Scalar>(best_alpha);
   const int spent = result.evaluations;
   const Status status = search_beta(model, params, observations, config, workspace, true, progress, result);
