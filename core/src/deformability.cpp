@@ -18,7 +18,9 @@ Status check_inputs(const MsmModel<Dim, Scalar>& model, const ObservationSequenc
       !(config.equilibrium_tolerance > 0)) {
     return Status::invalid_argument;
   }
-  if (ws.curve_capacity < config.grid_points + config.max_refinements) return Status::capacity_exceeded;
+  if (ws.curve_capacity < config.grid_points + config.max_refinements || ws.grid_capacity < config.grid_points) {
+    return Status::capacity_exceeded;
+  }
   if (obs.frame_count < 2 || obs.particle_count != model.particle_count || obs.times_s == nullptr ||
       obs.positions == nullptr || obs.driven_count < 0 || obs.driven_count > ws.driven_capacity ||
       (obs.driven_count > 0 && obs.driven == nullptr)) {
@@ -178,11 +180,12 @@ void run_final(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>&
                    nullptr, error);
 }
 
-// Evaluations one beta search plans: grid, golden-section steps, three curvature probes.
+// Evaluations one beta search plans: grid, Brent steps (bounded by the golden-section count,
+// which Brent's fallback never exceeds by more than a few), two curvature probes.
 int planned_search_evaluations(const DeformabilityConfig& config) noexcept {
   const double bracket = 2.0 / (config.grid_points - 1);
-  const int golden = static_cast<int>(std::ceil(std::log(bracket / config.tolerance) / std::log(1.618034))) + 2;
-  return config.grid_points + std::min(golden, config.max_refinements) + 3;
+  const int golden = static_cast<int>(std::ceil(std::log(bracket / config.tolerance) / std::log(1.618034)));
+  return config.grid_points + std::min(golden, config.max_refinements) + 2;
 }
 
 struct Minimum {
@@ -215,6 +218,68 @@ Minimum golden_section_minimum(F&& f, double lo, double hi, double tolerance, in
     }
   }
   return fa <= fb ? Minimum{a, fa} : Minimum{b, fb};
+}
+
+// Brent's minimisation (golden-section steps with parabolic interpolation where it is safe) on
+// the bracket [a, b] that holds the best known point x; w and v are the next best known points
+// (here the neighbouring grid samples, so the first step is already a parabola through three
+// samples). Stops when the bracket around x is narrower than `tolerance` on both sides or after
+// `max_evaluations` calls of f.
+struct Point {
+  double x = 0;
+  double value = 0;
+};
+template <typename F>
+Minimum brent_minimum(F&& f, double a, double b, Point x, Point w, Point v, double tolerance,
+                      int max_evaluations) noexcept {
+  constexpr double kGolden = 0.38196601125010515;  // (3 - sqrt 5) / 2
+  const double tol1 = 0.25 * tolerance;
+  double step = 0.0;           // last step taken
+  double earlier = b - a;      // the step before it
+  for (int evaluations = 0; evaluations < max_evaluations; ++evaluations) {
+    const double middle = 0.5 * (a + b);
+    if (std::max(x.x - a, b - x.x) <= 2.0 * tol1) break;
+    bool parabolic = false;
+    if (std::abs(earlier) > tol1) {
+      // Vertex of the parabola through x, w, v, as an offset p / q from x.
+      const double r = (x.x - w.x) * (x.value - v.value);
+      double q = (x.x - v.x) * (x.value - w.value);
+      double p = (x.x - v.x) * q - (x.x - w.x) * r;
+      q = 2.0 * (q - r);
+      if (q > 0.0) p = -p;
+      q = std::abs(q);
+      const double before = earlier;
+      earlier = step;
+      // Accept only a step inside the bracket and smaller than half the step before last.
+      if (q > 0.0 && std::abs(p) < std::abs(0.5 * q * before) && p > q * (a - x.x) && p < q * (b - x.x)) {
+        step = p / q;
+        const double u = x.x + step;
+        if (u - a < 2.0 * tol1 || b - u < 2.0 * tol1) step = middle >= x.x ? tol1 : -tol1;
+        parabolic = true;
+      }
+    }
+    if (!parabolic) {
+      earlier = x.x >= middle ? a - x.x : b - x.x;
+      step = kGolden * earlier;
+    }
+    const double u = x.x + (std::abs(step) >= tol1 ? step : (step >= 0.0 ? tol1 : -tol1));
+    const Point trial{u, f(u)};
+    if (trial.value <= x.value) {
+      if (u >= x.x) a = x.x; else b = x.x;
+      v = w;
+      w = x;
+      x = trial;
+    } else {
+      if (u < x.x) a = u; else b = u;
+      if (trial.value <= w.value || w.x == x.x) {
+        v = w;
+        w = trial;
+      } else if (trial.value <= v.value || v.x == x.x || v.x == w.x) {
+        v = trial;
+      }
+    }
+  }
+  return Minimum{x.x, x.value};
 }
 
 struct Progress {
@@ -264,9 +329,11 @@ Status search_beta(const MsmModel<Dim, Scalar>& model, MsmParams<Dim, Scalar> pa
   const int grid = config.grid_points;
   int best_grid = 0;
   double best_grid_error = std::numeric_limits<double>::infinity();
+  double* grid_errors = ws.grid_error;
   for (int i = 0; i < grid; ++i) {
     const double beta = static_cast<double>(i) / (grid - 1);
     const TrajectoryError e = evaluate(beta);
+    grid_errors[i] = e.count > 0 ? e.mean_distance : std::numeric_limits<double>::infinity();
     if (e.count > 0 && e.mean_distance < best_grid_error) {
       best_grid_error = e.mean_distance;
       best_grid = i;
@@ -276,14 +343,25 @@ Status search_beta(const MsmModel<Dim, Scalar>& model, MsmParams<Dim, Scalar> pa
   const bool grid_single = record ? single_basin(ws.curve_error, grid) : true;
   result.frames_without_observations = best.error.frames_without_observations;
 
-  // Golden-section search inside the bracket of the best grid point's neighbours.
+  // Brent refinement inside the bracket of the best grid point's neighbours, started from the
+  // three grid samples around it.
   const double step = 1.0 / (grid - 1);
-  double lo = std::max(0.0, (best_grid - 1) * step);
-  double hi = std::min(1.0, (best_grid + 1) * step);
-  (void)golden_section_minimum([&](double beta) { return evaluate(beta).mean_distance; }, lo, hi, config.tolerance,
-                               config.max_refinements);
+  const auto grid_point = [&](int i) {
+    const int k = std::clamp(i, 0, grid - 1);
+    return Point{static_cast<double>(k) * step, grid_errors[k]};
+  };
+  const double lo = std::max(0.0, (best_grid - 1) * step);
+  const double hi = std::min(1.0, (best_grid + 1) * step);
+  // w and v of Brent's method: the better and the worse neighbour (at an end of the grid, the
+  // next two points inward).
+  Point near_better = best_grid > 0 ? grid_point(best_grid - 1) : grid_point(best_grid + 2);
+  Point near_worse = best_grid < grid - 1 ? grid_point(best_grid + 1) : grid_point(best_grid - 2);
+  if (near_worse.value < near_better.value) std::swap(near_better, near_worse);
+  (void)brent_minimum([&](double beta) { return evaluate(beta).mean_distance; }, lo, hi, grid_point(best_grid),
+                      near_better, near_worse, config.tolerance, config.max_refinements);
 
-  // Uncertainty from the curvature of the sum of squares around the estimate.
+  // Uncertainty from the curvature of the sum of squares around the estimate: the estimate
+  // itself and one probe either side (the centre moves inward only at a bound).
   const double h = std::max(0.01, 2.0 * config.tolerance);
   const double centre = std::clamp(best.beta, h, 1.0 - h);
   const TrajectoryError left = evaluate(centre - h);
@@ -366,6 +444,8 @@ Status deformability_workspace_init(Arena& arena, const MsmModel<Dim, Scalar>& m
   ws.curve_capacity = config.grid_points + config.max_refinements + 4;
   ws.curve_beta = arena.carve<double>(static_cast<std::size_t>(ws.curve_capacity));
   ws.curve_error = arena.carve<double>(static_cast<std::size_t>(ws.curve_capacity));
+  ws.grid_capacity = config.grid_points;
+  ws.grid_error = arena.carve<double>(static_cast<std::size_t>(config.grid_points));
   if (arena.exhausted() || state_status != Status::ok) return Status::capacity_exceeded;
   workspace = ws;
   return Status::ok;

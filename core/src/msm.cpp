@@ -30,7 +30,7 @@ Eigen::Matrix<Scalar, 2, 2> rotation_of(const Eigen::Matrix<Scalar, 2, 2>& apq,
 template <typename Scalar>
 Eigen::Matrix<Scalar, 3, 3> rotation_of(const Eigen::Matrix<Scalar, 3, 3>& apq,
                                         Eigen::Quaternion<Scalar>& warm) noexcept {
-  (void)extract_rotation(apq, warm);
+  (void)extract_rotation(apq, warm, 24, simulation_rotation_tolerance<Scalar>());
   return warm.toRotationMatrix();
 }
 
@@ -87,7 +87,8 @@ Status msm_state_init(Arena& arena, const MsmModel<Dim, Scalar>& model, MsmState
   s.position = arena.carve<Vec>(n);
   s.velocity = arena.carve<Vec>(n);
   s.predicted = arena.carve<Vec>(n);
-  s.goal_sum = arena.carve<Vec>(n);
+  s.moment = arena.carve<Eigen::Matrix<Scalar, Dim, Dim + 1>>(n);
+  s.cluster_goal_map = arena.carve<Eigen::Matrix<Scalar, Dim, Dim + 1>>(c);
   s.driven_now = arena.carve<std::uint8_t>(n);
   s.rotation = arena.carve<ClusterRotation<Dim, Scalar>>(c);
   s.plastic = arena.carve<Mat>(c);
@@ -140,12 +141,11 @@ Status msm_step(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>
     }
   }
 
-  // 1. Prediction (eqs. 1-2). goal_sum doubles as the saved previous position.
+  // 1. Prediction (eqs. 1-2).
   const Scalar keep = std::max(Scalar(0), Scalar(1) - params.velocity_damping * dt);
   for (int i = 0; i < n; ++i) {
     const Vec& x = state.position[i];
     state.driven_now[i] = 0;
-    state.goal_sum[i].setZero();
     if (model.fixed[i] != 0) {
       state.predicted[i] = model.rest[i];
       continue;
@@ -176,21 +176,28 @@ Status msm_step(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>
     state.driven_now[id] = 1;
   }
 
-  // 2. Cluster shape matching (eqs. 3-13). Because sum m q0 = 0, A_pq = sum m x' q0^T, so one
-  // pass yields the centroid and A_pq.
+  // 2. Cluster shape matching (eqs. 3-13). With q0 = r - r_c and sum m q0 = 0,
+  // A_pq = sum m x q0^T = sum m x r^T - (sum m x) r_c^T: per-particle moments [m x r^T | m x]
+  // are formed once and each cluster sums them, instead of an outer product per membership.
+  // Coordinates are taken relative to the mean rest position and the step's mean position so
+  // that the cancellation in that difference stays small in float.
+  using Moment = Eigen::Matrix<Scalar, Dim, Dim + 1>;
+  Vec origin = Vec::Zero();
+  for (int i = 0; i < n; ++i) origin += state.predicted[i];
+  origin /= static_cast<Scalar>(n);
+  for (int i = 0; i < n; ++i) {
+    const Vec mx = model.mass[i] * (state.predicted[i] - origin);
+    Moment& moment = state.moment[i];
+    moment.template leftCols<Dim>().noalias() = mx * (model.rest[i] - model.rest_origin).transpose();
+    moment.col(Dim) = mx;
+  }
   const bool plastic_on = params.plastic_creep > Scalar(0);
   for (int c = 0; c < model.cluster_count; ++c) {
-    const int begin = model.cluster_begin[c];
-    const int end = model.cluster_begin[c + 1];
-    Vec weighted_sum = Vec::Zero();
-    Mat apq_rest = Mat::Zero();
-    for (int k = begin; k < end; ++k) {
-      const int j = model.members[k];
-      const Vec mx = model.mass[j] * state.predicted[j];
-      weighted_sum += mx;
-      apq_rest.noalias() += mx * model.member_rest_offset[k].transpose();
-    }
-    const Vec centroid = weighted_sum * model.cluster_inverse_mass[c];
+    Moment sum = Moment::Zero();
+    for (int k = model.cluster_begin[c]; k < model.cluster_begin[c + 1]; ++k) sum += state.moment[model.members[k]];
+    const Vec rest_centroid = model.cluster_rest_centroid[c] - model.rest_origin;
+    const Mat apq_rest = sum.template leftCols<Dim>() - sum.col(Dim) * rest_centroid.transpose();
+    const Vec centroid = sum.col(Dim) * model.cluster_inverse_mass[c];
     const Mat affine_rest = apq_rest * model.cluster_aqq_inverse[c];
     const Mat& plastic = state.plastic[c];
     const Mat rotation = plastic_on ? rotation_of(Mat(apq_rest * plastic.transpose()), state.rotation[c])
@@ -199,13 +206,14 @@ Status msm_step(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>
     // Goal map applied to q0: ((1 - beta) R + beta A) S_p q0 = (1 - beta) R S_p q0 + beta A0 q0.
     const Mat goal_map = plastic_on ? Mat((Scalar(1) - beta) * rotation * plastic + beta * affine_rest)
                                     : Mat((Scalar(1) - beta) * rotation + beta * affine_rest);
-    for (int k = begin; k < end; ++k) {
-      state.goal_sum[model.members[k]] += goal_map * model.member_rest_offset[k] + centroid;
-    }
+    // goal(r) = G (r - r_c) + t = G r + (t - G r_c), all relative to the origins.
+    Moment& map = state.cluster_goal_map[c];
+    map.template leftCols<Dim>() = goal_map;
+    map.col(Dim).noalias() = centroid - goal_map * rest_centroid;
     if (plastic_on) update_plastic<Dim, Scalar>(params, dt, rotation, affine_rest, state.plastic[c]);
   }
 
-  // 3. Integration (eqs. 10-11) with averaged goals.
+  // 3. Integration (eqs. 10-11) with goals averaged over each particle's clusters.
   const Scalar inverse_dt = Scalar(1) / dt;
   for (int i = 0; i < n; ++i) {
     const Vec previous = state.position[i];
@@ -215,8 +223,13 @@ Status msm_step(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>
     } else if (state.driven_now[i] != 0) {
       next = state.predicted[i];  // the goal of a driven particle is its target
     } else if (model.inverse_cluster_count[i] > Scalar(0)) {
-      const Vec goal = state.goal_sum[i] * model.inverse_cluster_count[i];
-      next = state.predicted[i] + params.msm_alpha * (goal - state.predicted[i]);
+      Moment map_sum = Moment::Zero();
+      for (int k = model.particle_cluster_begin[i]; k < model.particle_cluster_begin[i + 1]; ++k) {
+        map_sum += state.cluster_goal_map[model.particle_clusters[k]];
+      }
+      const Vec goal_offset = (map_sum.template leftCols<Dim>() * (model.rest[i] - model.rest_origin) + map_sum.col(Dim)) *
+                              model.inverse_cluster_count[i];
+      next = state.predicted[i] + params.msm_alpha * (origin + goal_offset - state.predicted[i]);
     } else {
       next = state.predicted[i];
     }

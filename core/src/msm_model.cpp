@@ -226,6 +226,8 @@ Status build(Arena& arena, const MsmModelConfig<Dim, Scalar>& config, MsmModel<D
   m.cluster_rest_centroid = arena.carve<Vec>(static_cast<std::size_t>(clusters));
   m.cluster_inverse_mass = arena.carve<Scalar>(static_cast<std::size_t>(clusters));
   m.cluster_aqq_inverse = arena.carve<Mat>(static_cast<std::size_t>(clusters));
+  m.particle_cluster_begin = arena.carve<std::int32_t>(static_cast<std::size_t>(n) + 1);
+  m.particle_clusters = arena.carve<std::int32_t>(static_cast<std::size_t>(memberships));
   if (arena.exhausted()) return Status::capacity_exceeded;
 
   for (int i = 0; i < n; ++i) {
@@ -249,6 +251,27 @@ Status build(Arena& arena, const MsmModelConfig<Dim, Scalar>& config, MsmModel<D
     m.inverse_cluster_count[j] += Scalar(1);
   });
   while (current < clusters) m.cluster_begin[++current] = filled;
+
+  // Transposed lists (particle -> clusters), by counting then filling.
+  m.particle_cluster_begin[0] = 0;
+  for (int i = 0; i < n; ++i) {
+    m.particle_cluster_begin[i + 1] = m.particle_cluster_begin[i] + static_cast<std::int32_t>(m.inverse_cluster_count[i]);
+  }
+  for (int c = 0; c < clusters; ++c) {
+    for (int k = m.cluster_begin[c]; k < m.cluster_begin[c + 1]; ++k) {
+      const int j = m.members[k];
+      // inverse_cluster_count[j] still holds the count; use it as a countdown cursor.
+      m.inverse_cluster_count[j] -= Scalar(1);
+      m.particle_clusters[m.particle_cluster_begin[j] + static_cast<std::int32_t>(m.inverse_cluster_count[j])] = c;
+    }
+  }
+  VecD origin = VecD::Zero();
+  for (int i = 0; i < n; ++i) {
+    origin += m.rest[i].template cast<double>();
+    const int held_count = m.particle_cluster_begin[i + 1] - m.particle_cluster_begin[i];
+    m.inverse_cluster_count[i] = static_cast<Scalar>(held_count);
+  }
+  m.rest_origin = (origin / static_cast<double>(n)).template cast<Scalar>();
 
   for (int i = 0; i < n; ++i) {
     const Scalar held = m.inverse_cluster_count[i];

@@ -11,9 +11,10 @@
 // observed (frame, particle) pairs of free particles (neither fixed nor driven at that time);
 // prescribed particles carry no information about beta and are left out.
 //
-// Search: E on a uniform grid over [0, 1], then golden-section refinement around the best grid
-// point until the bracket is below `tolerance`; bounded by grid_points + max_refinements + 2
-// evaluations (x ~10 with estimate_alpha). Uncertainty: curvature of the sum of squared
+// Search: E on a uniform grid over [0, 1], then Brent refinement (parabolic steps through the
+// samples, golden-section steps where a parabola is unsafe) inside the best grid point's
+// neighbours until the bracket is below `tolerance`; bounded by grid_points + max_refinements
+// + 2 evaluations (x ~10 with estimate_alpha). Typically 6-8 refinement steps. Uncertainty: curvature of the sum of squared
 // residuals at the minimum (curve_analysis.hpp), widened by the design effect of residuals that
 // persist per particle over time (each particle's frames are one correlated cluster). unique_minimum is false when the grid curve
 // has a second basin, is flat, or the curvature is not positive.
@@ -80,6 +81,8 @@ struct DeformabilityWorkspace {
   int curve_capacity = 0;
   double* curve_beta = nullptr;  ///< [curve_capacity] E(beta) samples of the last estimate
   double* curve_error = nullptr; ///< [curve_capacity]
+  double* grid_error = nullptr;  ///< [grid_capacity] scratch: E on the uniform grid
+  int grid_capacity = 0;
 };
 
 template <int Dim, typename Scalar>

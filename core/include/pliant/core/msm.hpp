@@ -54,7 +54,10 @@ struct MsmState {
   Vec* position = nullptr;   ///< [particle_count]
   Vec* velocity = nullptr;   ///< [particle_count], length unit / s
   Vec* predicted = nullptr;  ///< [particle_count] scratch
-  Vec* goal_sum = nullptr;   ///< [particle_count] scratch
+  /// Step scratch: per particle [m x q^T | m x] and per cluster the goal map [G | b] with
+  /// goal = G r + b (both relative to the origins in MsmModel::rest_origin and the step's mean).
+  Eigen::Matrix<Scalar, Dim, Dim + 1>* moment = nullptr;          ///< [particle_count]
+  Eigen::Matrix<Scalar, Dim, Dim + 1>* cluster_goal_map = nullptr;  ///< [cluster_count]
   std::uint8_t* driven_now = nullptr;  ///< [particle_count] 1 while driven in the last step
   ClusterRotation<Dim, Scalar>* rotation = nullptr;  ///< [cluster_count]
   Mat* plastic = nullptr;    ///< [cluster_count] S_p, identity when no plastic set

@@ -79,6 +79,13 @@ struct MsmModel {
   Vec* cluster_rest_centroid = nullptr;     ///< [cluster_count]
   Scalar* cluster_inverse_mass = nullptr;   ///< [cluster_count]
   Mat* cluster_aqq_inverse = nullptr;       ///< [cluster_count] pseudo-inverse of sum m q0 q0^T
+  /// Transpose of the cluster lists: particle i belongs to the clusters
+  /// particle_clusters[particle_cluster_begin[i] .. particle_cluster_begin[i + 1]).
+  std::int32_t* particle_cluster_begin = nullptr;  ///< [particle_count + 1]
+  std::int32_t* particle_clusters = nullptr;       ///< [membership_count] cluster ids
+  /// Mean rest position. The step works in coordinates relative to it (rest) and to the
+  /// current mean position (deformed), which keeps float sums of x q^T precise.
+  Vec rest_origin = Vec::Zero();
 
   bool initialized() const noexcept { return particle_count > 0 && rest != nullptr; }
 };
