@@ -65,6 +65,26 @@ void update_plastic(const MsmParams<Dim, Scalar>& params, Scalar dt,
   plastic = next;
 }
 
+// A support particle in its plane (through its rest position, normal n into the object): the
+// normal offset is undone (the support holds it in the plane, as a pin does); the tangential
+// move since the last step is cancelled while it is within mu x that normal correction (stick)
+// and shortened by that much otherwise (slip). mu -> infinity is the pin exactly.
+template <int Dim, typename Scalar>
+Eigen::Matrix<Scalar, Dim, 1> support_contact(const MsmParams<Dim, Scalar>& params,
+                                              const Eigen::Matrix<Scalar, Dim, 1>& rest,
+                                              const Eigen::Matrix<Scalar, Dim, 1>& previous,
+                                              Eigen::Matrix<Scalar, Dim, 1> next) noexcept {
+  const Eigen::Matrix<Scalar, Dim, 1>& normal = params.support_normal;
+  const Scalar correction = normal.dot(rest - next);
+  next += correction * normal;
+  Eigen::Matrix<Scalar, Dim, 1> slide = next - previous;
+  slide -= normal.dot(slide) * normal;
+  const Scalar length = slide.norm();
+  const Scalar limit = params.support_friction * std::abs(correction);
+  if (length <= limit) return next - slide;
+  return next - slide * (limit / length);
+}
+
 }  // namespace
 
 template <int Dim, typename Scalar>
@@ -92,6 +112,7 @@ Status msm_state_init(Arena& arena, const MsmModel<Dim, Scalar>& model, MsmState
   s.driven_now = arena.carve<std::uint8_t>(n);
   s.rotation = arena.carve<ClusterRotation<Dim, Scalar>>(c);
   s.plastic = arena.carve<Mat>(c);
+  s.relaxed = arena.carve<Mat>(c);
   if (arena.exhausted()) return Status::capacity_exceeded;
   state = s;
   msm_state_reset(model, state);
@@ -109,6 +130,7 @@ void msm_state_reset(const MsmModel<Dim, Scalar>& model, MsmState<Dim, Scalar>& 
   for (int c = 0; c < model.cluster_count; ++c) {
     identity_rotation<Dim, Scalar>(state.rotation[c]);
     state.plastic[c].setIdentity();
+    state.relaxed[c].setIdentity();
   }
   state.time_s = 0;
   state.steps = 0;
@@ -125,7 +147,13 @@ Status msm_step(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>
                          params.msm_alpha <= Scalar(1) && finite(params.msm_beta) &&
                          params.msm_beta >= Scalar(0) && params.msm_beta <= Scalar(1) &&
                          params.gravity.allFinite() && finite(params.velocity_damping) &&
-                         params.velocity_damping >= Scalar(0);
+                         params.velocity_damping >= Scalar(0) && finite(params.relaxation_fraction) &&
+                         params.relaxation_fraction >= Scalar(0) && params.relaxation_fraction < Scalar(1) &&
+                         finite(params.relaxation_time_s) && params.relaxation_time_s > Scalar(0) &&
+                         finite(params.stiffening) && params.stiffening >= Scalar(0) &&
+                         params.support_friction >= Scalar(0) &&
+                         (!finite(params.support_friction) ||
+                          std::abs(params.support_normal.squaredNorm() - Scalar(1)) < Scalar(1e-3));
   if (!finite(dt) || !(dt > Scalar(0)) || !params_ok || input.driven.count < 0 ||
       (input.driven.count > 0 && (input.driven.ids == nullptr || input.driven.positions == nullptr))) {
     ++state.rejected_steps;
@@ -141,12 +169,13 @@ Status msm_step(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>
     }
   }
 
+  const bool pinned = !finite(params.support_friction);
   // 1. Prediction (eqs. 1-2).
   const Scalar keep = std::max(Scalar(0), Scalar(1) - params.velocity_damping * dt);
   for (int i = 0; i < n; ++i) {
     const Vec& x = state.position[i];
     state.driven_now[i] = 0;
-    if (model.fixed[i] != 0) {
+    if (model.fixed[i] != 0 && pinned) {
       state.predicted[i] = model.rest[i];
       continue;
     }
@@ -192,6 +221,11 @@ Status msm_step(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>
     moment.col(Dim) = mx;
   }
   const bool plastic_on = params.plastic_creep > Scalar(0);
+  const bool relax_on = params.relaxation_fraction > Scalar(0);
+  const bool stiffen_on = params.stiffening > Scalar(0);
+  const bool rest_changes = plastic_on || relax_on;
+  // Exact decay of V toward the strain over one step, stable for any dt / tau.
+  const Scalar relax_rate = relax_on ? Scalar(1) - std::exp(-dt / params.relaxation_time_s) : Scalar(0);
   for (int c = 0; c < model.cluster_count; ++c) {
     Moment sum = Moment::Zero();
     for (int k = model.cluster_begin[c]; k < model.cluster_begin[c + 1]; ++k) sum += state.moment[model.members[k]];
@@ -199,18 +233,37 @@ Status msm_step(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>
     const Mat apq_rest = sum.template leftCols<Dim>() - sum.col(Dim) * rest_centroid.transpose();
     const Vec centroid = sum.col(Dim) * model.cluster_inverse_mass[c];
     const Mat affine_rest = apq_rest * model.cluster_aqq_inverse[c];
-    const Mat& plastic = state.plastic[c];
-    const Mat rotation = plastic_on ? rotation_of(Mat(apq_rest * plastic.transpose()), state.rotation[c])
-                                    : rotation_of(apq_rest, state.rotation[c]);
-    const Scalar beta = params.cluster_beta != nullptr ? params.cluster_beta[c] : params.msm_beta;
-    // Goal map applied to q0: ((1 - beta) R + beta A) S_p q0 = (1 - beta) R S_p q0 + beta A0 q0.
-    const Mat goal_map = plastic_on ? Mat((Scalar(1) - beta) * rotation * plastic + beta * affine_rest)
-                                    : Mat((Scalar(1) - beta) * rotation + beta * affine_rest);
+    // Rest deformation E: plastic set S_p and relaxed share (1 - g1) I + g1 V (identity when off).
+    Mat rest_deformation = Mat::Identity();
+    if (rest_changes) {
+      rest_deformation = plastic_on ? state.plastic[c] : Mat::Identity();
+      if (relax_on) {
+        rest_deformation = rest_deformation * ((Scalar(1) - params.relaxation_fraction) * Mat::Identity() +
+                                               params.relaxation_fraction * state.relaxed[c]);
+      }
+    }
+    const Mat rotation = rest_changes ? rotation_of(Mat(apq_rest * rest_deformation.transpose()), state.rotation[c])
+                                      : rotation_of(apq_rest, state.rotation[c]);
+    Scalar beta = params.cluster_beta != nullptr ? params.cluster_beta[c] : params.msm_beta;
+    Mat strain = Mat::Zero();  // sym(R^T A) - I, formed only when an effect needs it
+    if (stiffen_on || relax_on) {
+      const Mat stretch = rotation.transpose() * affine_rest;
+      strain = Scalar(0.5) * (stretch + stretch.transpose()) - Mat::Identity();
+    }
+    if (stiffen_on) beta /= Scalar(1) + params.stiffening * strain.norm();
+    // Goal map applied to q0: ((1 - beta) R + beta A) E q0 = (1 - beta) R E q0 + beta A0 q0.
+    const Mat goal_map = rest_changes ? Mat((Scalar(1) - beta) * rotation * rest_deformation + beta * affine_rest)
+                                      : Mat((Scalar(1) - beta) * rotation + beta * affine_rest);
     // goal(r) = G (r - r_c) + t = G r + (t - G r_c), all relative to the origins.
     Moment& map = state.cluster_goal_map[c];
     map.template leftCols<Dim>() = goal_map;
     map.col(Dim).noalias() = centroid - goal_map * rest_centroid;
     if (plastic_on) update_plastic<Dim, Scalar>(params, dt, rotation, affine_rest, state.plastic[c]);
+    if (relax_on) {
+      Mat& relaxed = state.relaxed[c];
+      const Mat target = strain + Mat::Identity();
+      if (target.allFinite()) relaxed += relax_rate * (target - relaxed);
+    }
   }
 
   // 3. Integration (eqs. 10-11) with goals averaged over each particle's clusters.
@@ -218,7 +271,7 @@ Status msm_step(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>
   for (int i = 0; i < n; ++i) {
     const Vec previous = state.position[i];
     Vec next;
-    if (model.fixed[i] != 0) {
+    if (model.fixed[i] != 0 && pinned) {
       next = model.rest[i];
     } else if (state.driven_now[i] != 0) {
       next = state.predicted[i];  // the goal of a driven particle is its target
@@ -233,6 +286,7 @@ Status msm_step(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>
     } else {
       next = state.predicted[i];
     }
+    if (model.fixed[i] != 0 && !pinned) next = support_contact(params, model.rest[i], previous, next);
     state.position[i] = next;
     state.velocity[i] = (next - previous) * inverse_dt;
   }

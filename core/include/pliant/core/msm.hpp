@@ -9,7 +9,9 @@
 //      x = x' + alpha (g - x'), v = (x - x_old) / dt                               (eqs. 10-11).
 // With plasticity on (plastic_creep > 0), each cluster carries a plastic deformation S_p that
 // yields and creeps toward the cluster's strain (Mueller et al. 2005, section 4.4); rest offsets
-// become S_p q0.
+// become S_p q0. Relaxation, stiffening and support friction (MsmParams) extend the model the
+// same way; each reduces exactly to the elastic model at its null value, which is what lets
+// `diagnose` test whether the data need it.
 //
 // Real-time contract: msm_step and msm_state_reset are O(memberships + clusters), allocate
 // nothing, throw nothing. Non-finite inputs never reach the state: a NaN target is dropped
@@ -40,6 +42,21 @@ struct MsmParams {
   Scalar plastic_yield = 0;
   Scalar plastic_creep = 0;  ///< 1/s
   Scalar plastic_max = 1;
+  /// Viscoelastic relaxation (off while relaxation_fraction == 0): a share g1 of each cluster's
+  /// rest shape relaxes toward its current strain with time constant relaxation_time_s, so
+  /// the object creeps under a held load and recovers slowly after release.
+  Scalar relaxation_fraction = 0;  ///< g1 in [0, 1)
+  Scalar relaxation_time_s = 1;    ///< tau, s, > 0
+  /// Strain stiffening (off while 0): cluster beta = beta / (1 + stiffening * |strain|), with
+  /// |strain| the Frobenius norm of sym(R^T A) - I.
+  Scalar stiffening = 0;
+  /// Support friction: infinity (default) pins `fixed` particles at rest. Finite mu keeps them
+  /// in their support plane (through their rest position, normal `support_normal`) but lets
+  /// them slide along it when the tangential move exceeds mu times the normal correction the
+  /// plane applies that step (Coulomb friction in position form; the normal correction stands
+  /// in for the normal force). mu -> infinity is the pin.
+  Scalar support_friction = std::numeric_limits<Scalar>::infinity();
+  Vec support_normal = Vec::Zero();  ///< unit vector; required when support_friction is finite
 };
 
 /// Per-cluster rotation kept between steps: the 2D matrix or the 3D quaternion warm start.
@@ -61,6 +78,7 @@ struct MsmState {
   std::uint8_t* driven_now = nullptr;  ///< [particle_count] 1 while driven in the last step
   ClusterRotation<Dim, Scalar>* rotation = nullptr;  ///< [cluster_count]
   Mat* plastic = nullptr;    ///< [cluster_count] S_p, identity when no plastic set
+  Mat* relaxed = nullptr;    ///< [cluster_count] relaxed strain V (identity at rest)
   double time_s = 0;         ///< sum of accepted dt
   std::uint32_t steps = 0;
   std::uint32_t dropped_targets = 0;  ///< driven targets ignored for being non-finite
