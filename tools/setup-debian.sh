@@ -11,6 +11,7 @@ packages=(
   libgtest-dev                   # unit tests
   libbenchmark-dev               # bench/
   clang libclang-rt-14-dev       # libFuzzer targets and their sanitizer runtimes
+  chromium                       # headless browser for the report rendering test
 )
 
 missing=()

@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "command_diagnose.hpp"
 #include "command_estimate.hpp"
 #include "command_simulate.hpp"
 #include "exit_status.hpp"
@@ -36,6 +37,7 @@ int run(int argc, char** argv) {
       "Exit status: 0 success, 1 runtime failure, 2 usage error or malformed recording.");
   EstimateCommand estimate(app);
   SimulateCommand simulate(app);
+  DiagnoseCommand diagnose(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& done) {  // --help, --version
@@ -45,6 +47,7 @@ int run(int argc, char** argv) {
   }
   if (estimate.selected()) return run_reporting_errors("pliant estimate", [&] { return estimate.run(); });
   if (simulate.selected()) return run_reporting_errors("pliant simulate", [&] { return simulate.run(); });
+  if (diagnose.selected()) return run_reporting_errors("pliant diagnose", [&] { return diagnose.run(); });
   std::cerr << app.help();
   return exit_usage;
 }

@@ -1,0 +1,61 @@
+#include "command_diagnose.hpp"
+
+#include <iostream>
+#include <stdexcept>
+
+#include "atomic_write.hpp"
+#include "exit_status.hpp"
+#include "progress_bar.hpp"
+#include "pliant/host/diagnose/diagnose.hpp"
+#include "pliant/host/diagnose/html_report.hpp"
+#include "pliant/host/recording.hpp"
+
+namespace pliant::cli {
+
+DiagnoseCommand::DiagnoseCommand(CLI::App& parent) {
+  app_ = parent.add_subcommand("diagnose",
+                               "Locate where the elastic model and a recording disagree, name the physics it left "
+                               "out, model it and show the fit improve");
+  app_->footer(
+      "Prints a short summary. Exit status: 0 ok (whatever the verdict), 1 the recording cannot be diagnosed "
+      "(too few frames, nothing moves, nothing observed), 2 bad options or a malformed recording.");
+  app_->add_option("REC", recording_, "Recording directory (docs/spec/recording-v1.md)")->required();
+  app_->add_option("--json", json_path_, "Also write the pliant-diagnosis v1 JSON to OUT; '-' prints it instead")
+      ->type_name("OUT");
+  app_->add_option("--report", report_dir_, "Write an HTML report with plots to DIR/index.html")->type_name("DIR");
+  app_->add_option("--model", model_, "Baseline model (fem arrives with the FEM work)")
+      ->type_name("msm|fem")
+      ->capture_default_str();
+  app_->add_flag("-q,--quiet", quiet_, "No progress bar");
+}
+
+int DiagnoseCommand::run() const {
+  if (model_ != "msm" && model_ != "fem") throw UsageError("--model must be msm or fem");
+  if (model_ == "fem") throw UsageError("--model fem is not available yet; use --model msm");
+  const host::Recording recording = host::read_recording(recording_);
+  for (const std::string& warning : recording.warnings) report_warning(warning);
+
+  host::DiagnoseResult result;
+  {
+    ProgressBar bar("diagnosing", !quiet_);
+    host::DiagnoseOptions options;
+    options.model = model_;
+    options.progress = [&bar](const std::string&, int done, int total) { bar.update(done, total); };
+    result = host::diagnose_recording(recording, options);
+  }
+  const nlohmann::json document = host::diagnosis_json(result.diagnosis);
+  if (!report_dir_.empty()) host::write_diagnosis_report(result.diagnosis, result.evidence, report_dir_);
+  if (json_path_ == "-") {
+    std::cout << document.dump(2) << '\n';
+  } else {
+    if (!json_path_.empty()) write_file_atomically(json_path_, document.dump(2) + "\n");
+    std::cout << host::diagnosis_summary(result.diagnosis, recording.length_unit);
+    if (!json_path_.empty()) std::cout << "wrote " << json_path_ << '\n';
+    if (!report_dir_.empty()) std::cout << "wrote " << report_dir_ << "/index.html\n";
+  }
+  std::cout.flush();
+  if (!std::cout) throw std::runtime_error("cannot write to standard output");
+  return exit_ok;
+}
+
+}  // namespace pliant::cli

@@ -1,0 +1,52 @@
+// `pliant diagnose`: where the elastic MSM baseline disagrees with a recording, which physics
+// it left out, that physics modelled and the fit shown to improve (docs/spec/diagnosis-v1.md,
+// method in shared DIAGNOSIS.md, summarised in docs/diagnose.md).
+//
+// Procedure
+// 1. Frames are split into interleaved blocks; odd blocks are held out of every fit and every
+//    rms reported is measured on them.
+// 2. Baseline: msm_beta fitted on the fitting frames (grid + golden section), pinned supports,
+//    gravity only if declared, msm_alpha 1. Noise: measured from the recording alone.
+// 3. Locate: residual field of the baseline, the particles and window where it concentrates,
+//    and the signature statistics.
+// 4. Every catalogued effect (effects.hpp) is refitted with msm_beta through the simulator by
+//    bounded coordinate search; uncertainty from a finite-difference Jacobian.
+// 5. Select: an effect is named only when its held-out rms improves clearly on the baseline,
+//    its BIC gain is >= 10, its parameter is >= 3 standard deviations from the null and the
+//    baseline misfit stands clearly above the noise floor; otherwise `consistent`.
+// Host code: allocates, throws std::runtime_error with one line when a recording cannot be
+// diagnosed (too few frames, nothing moves, nothing observed).
+#pragma once
+
+#include <functional>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "pliant/host/diagnose/diagnosis.hpp"
+#include "pliant/host/recording.hpp"
+
+namespace pliant::host {
+
+struct DiagnoseOptions {
+  std::string model = "msm";  ///< only "msm" today; "fem" arrives with the FEM issue
+  int holdout_block_frames = 0;  ///< 0: about a tenth of a second of frames (at least 3)
+  /// Progress (stage name, done, total); may be empty.
+  std::function<void(const std::string&, int, int)> progress;
+};
+
+struct DiagnoseResult {
+  Diagnosis diagnosis;
+  DiagnosisEvidence evidence;
+  double runtime_s = 0;
+};
+
+DiagnoseResult diagnose_recording(const Recording& recording, const DiagnoseOptions& options);
+
+/// The pliant-diagnosis v1 document.
+nlohmann::json diagnosis_json(const Diagnosis& diagnosis);
+
+/// A few lines for a terminal.
+std::string diagnosis_summary(const Diagnosis& diagnosis, const std::string& length_unit);
+
+}  // namespace pliant::host

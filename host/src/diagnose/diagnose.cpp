@@ -1,0 +1,568 @@
+#include "pliant/host/diagnose/diagnose.hpp"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "pliant/host/diagnose/effects.hpp"
+#include "pliant/host/diagnose/holdout.hpp"
+#include "pliant/host/diagnose/locate.hpp"
+#include "pliant/host/diagnose/model_run.hpp"
+#include "pliant/host/diagnose/noise_floor.hpp"
+#include "pliant/host/diagnose/residual_field.hpp"
+
+namespace pliant::host {
+namespace {
+
+constexpr int kMinFrames = 10;
+constexpr double kMinImprovement = 0.3;   // held-out rms must fall by 30 % ...
+constexpr double kMinBicGain = 10.0;      // ... with "very strong" evidence (Kass-Raftery) ...
+constexpr double kMinSignificance = 3.0;  // ... and a parameter 3 std from its null
+constexpr double kMinMisfit = 1.5;        // baseline held-out rms / noise rms worth explaining
+constexpr double kUnknownMisfit = 5.0;    // unexplained misfit that is reported as `unknown`
+
+// Sums of squared Euclidean residuals over the compared pairs of fitting and held-out frames.
+struct Score {
+  double fit_rss = 0;
+  long fit_pairs = 0;
+  double held_rss = 0;
+  long held_pairs = 0;
+  double fit_rms() const { return fit_pairs > 0 ? std::sqrt(fit_rss / static_cast<double>(fit_pairs)) : 0.0; }
+  double held_rms() const { return held_pairs > 0 ? std::sqrt(held_rss / static_cast<double>(held_pairs)) : 0.0; }
+};
+
+class Scorer {
+ public:
+  Scorer(const Recording& recording, std::vector<unsigned char> pairs, std::vector<unsigned char> held_out)
+      : recording_(recording), pairs_(std::move(pairs)), held_out_(std::move(held_out)) {}
+
+  Score score(const std::vector<double>& simulated) const {
+    Score s;
+    const int n = recording_.particle_count;
+    const int dim = recording_.dimension;
+    for (int k = 0; k < recording_.frame_count(); ++k) {
+      const bool held = held_out_[static_cast<std::size_t>(k)] != 0;
+      for (int i = 0; i < n; ++i) {
+        const std::size_t pair = static_cast<std::size_t>(k) * static_cast<std::size_t>(n) + static_cast<std::size_t>(i);
+        if (pairs_[pair] == 0) continue;
+        double squared = 0;
+        for (int d = 0; d < dim; ++d) {
+          const double r = simulated[pair * static_cast<std::size_t>(dim) + static_cast<std::size_t>(d)] - recording_.position(k, i, d);
+          squared += r * r;
+        }
+        if (!std::isfinite(squared)) continue;
+        if (held) {
+          s.held_rss += squared;
+          ++s.held_pairs;
+        } else {
+          s.fit_rss += squared;
+          ++s.fit_pairs;
+        }
+      }
+    }
+    return s;
+  }
+
+  /// Residual scalars on fitting pairs, in a fixed order (for the Jacobian).
+  Eigen::VectorXd fit_residuals(const std::vector<double>& simulated) const {
+    std::vector<double> values;
+    const int n = recording_.particle_count;
+    const int dim = recording_.dimension;
+    for (int k = 0; k < recording_.frame_count(); ++k) {
+      if (held_out_[static_cast<std::size_t>(k)] != 0) continue;
+      for (int i = 0; i < n; ++i) {
+        const std::size_t pair = static_cast<std::size_t>(k) * static_cast<std::size_t>(n) + static_cast<std::size_t>(i);
+        if (pairs_[pair] == 0) continue;
+        for (int d = 0; d < dim; ++d) {
+          const double r = simulated[pair * static_cast<std::size_t>(dim) + static_cast<std::size_t>(d)] - recording_.position(k, i, d);
+          values.push_back(std::isfinite(r) ? r : 0.0);
+        }
+      }
+    }
+    return Eigen::Map<Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
+  }
+
+  const std::vector<unsigned char>& held_out() const { return held_out_; }
+
+ private:
+  const Recording& recording_;
+  std::vector<unsigned char> pairs_;
+  std::vector<unsigned char> held_out_;
+};
+
+struct Fit {
+  std::vector<double> u;       // search coordinates: [0] msm_beta, then the effect's
+  std::vector<double> values;  // physical effect parameter values
+  std::vector<double> std;     // one std per effect parameter (inf when not identifiable)
+  double beta = 0;
+  double beta_std = 0;
+  Score score;
+  std::vector<double> simulated;
+  double bic = 0;
+};
+
+// Golden-section search of f on [lo, hi] to `tolerance`, starting from a known best point.
+template <typename F>
+double golden(F&& f, double lo, double hi, double tolerance, double& best_x, double& best_value) {
+  const double ratio = 0.5 * (std::sqrt(5.0) - 1.0);
+  double a = hi - ratio * (hi - lo);
+  double b = lo + ratio * (hi - lo);
+  double fa = f(a);
+  double fb = f(b);
+  auto keep = [&](double x, double v) {
+    if (v < best_value) {
+      best_value = v;
+      best_x = x;
+    }
+  };
+  keep(a, fa);
+  keep(b, fb);
+  while (hi - lo > tolerance) {
+    if (fa <= fb) {
+      hi = b;
+      b = a;
+      fb = fa;
+      a = hi - ratio * (hi - lo);
+      fa = f(a);
+      keep(a, fa);
+    } else {
+      lo = a;
+      a = b;
+      fa = fb;
+      b = lo + ratio * (hi - lo);
+      fb = f(b);
+      keep(b, fb);
+    }
+  }
+  return best_x;
+}
+
+class Fitter {
+ public:
+  Fitter(const RecordingSimulator& simulator, const Scorer& scorer, const EffectContext& context)
+      : simulator_(simulator), scorer_(scorer), context_(context) {}
+
+  ModelSettings settings(const Effect* effect, double beta, const std::vector<double>& values) const {
+    ModelSettings s;
+    s.msm_beta = std::clamp(beta, 0.0, 1.0);
+    if (effect != nullptr) effect->apply(values, context_, s);
+    return s;
+  }
+
+  std::vector<double> physical(const Effect* effect, const std::vector<double>& u) const {
+    std::vector<double> values;
+    if (effect == nullptr) return values;
+    for (std::size_t p = 0; p < effect->parameters.size(); ++p) values.push_back(effect->parameters[p].value(u[p + 1]));
+    return values;
+  }
+
+  double objective(const Effect* effect, const std::vector<double>& u) {
+    ++evaluations;
+    const std::vector<double> sim = simulator_.simulate(settings(effect, u[0], physical(effect, u)));
+    return scorer_.score(sim).fit_rss;
+  }
+
+  // Coordinate search: a coarse scan then golden section per coordinate, two sweeps.
+  Fit fit(const Effect* effect, double start_beta) {
+    std::vector<double> u(1, start_beta);
+    if (effect != nullptr) {
+      for (const EffectParameter& p : effect->parameters) {
+        double start = 0.0;
+        if (p.name == "region_msm_beta") start = start_beta;
+        else if (p.lower < p.null_value && p.null_value < p.upper) start = (p.null_value - p.lower) / (p.upper - p.lower);
+        u.push_back(start);
+      }
+    }
+    double best = objective(effect, u);
+    const int coordinates = static_cast<int>(u.size());
+    for (int sweep = 0; sweep < 2; ++sweep) {
+      for (int c = coordinates - 1; c >= 0; --c) {
+        const bool is_beta = c == 0;
+        const auto along = [&](double x) {
+          std::vector<double> trial = u;
+          trial[static_cast<std::size_t>(c)] = x;
+          return objective(effect, trial);
+        };
+        double best_x = u[static_cast<std::size_t>(c)];
+        double lo = 0;
+        double hi = 1;
+        if (sweep == 0 && !is_beta) {
+          // Scan: effect parameters can be flat near their null (a yield above every strain).
+          constexpr int kScan = 6;
+          for (int i = 0; i < kScan; ++i) {
+            const double x = static_cast<double>(i) / (kScan - 1);
+            const double v = along(x);
+            if (v < best) {
+              best = v;
+              best_x = x;
+            }
+          }
+          lo = std::max(0.0, best_x - 0.2);
+          hi = std::min(1.0, best_x + 0.2);
+        } else {
+          const double half = is_beta ? (sweep == 0 ? 0.15 : 0.05) : 0.1;
+          lo = std::max(0.0, best_x - half);
+          hi = std::min(1.0, best_x + half);
+        }
+        golden(along, lo, hi, is_beta ? 2e-3 : 1e-2, best_x, best);
+        u[static_cast<std::size_t>(c)] = best_x;
+      }
+      if (effect == nullptr) break;
+    }
+    return finish(effect, u);
+  }
+
+  Fit finish(const Effect* effect, const std::vector<double>& u) {
+    Fit f;
+    f.u = u;
+    f.beta = u[0];
+    f.values = physical(effect, u);
+    f.simulated = simulator_.simulate(settings(effect, f.beta, f.values));
+    f.score = scorer_.score(f.simulated);
+    // Uncertainty: J = d residual / d parameter by central differences; cov = s^2 (J^T J)^-1.
+    const Eigen::VectorXd r0 = scorer_.fit_residuals(f.simulated);
+    const int p = static_cast<int>(u.size());
+    Eigen::MatrixXd jacobian(r0.size(), p);
+    for (int c = 0; c < p; ++c) {
+      const double h = 0.01;
+      std::vector<double> up = u;
+      std::vector<double> down = u;
+      up[static_cast<std::size_t>(c)] = std::min(1.0, u[static_cast<std::size_t>(c)] + h);
+      down[static_cast<std::size_t>(c)] = std::max(0.0, u[static_cast<std::size_t>(c)] - h);
+      const std::vector<double> vu = physical(effect, up);
+      const std::vector<double> vd = physical(effect, down);
+      const double step = c == 0 ? up[0] - down[0] : vu[static_cast<std::size_t>(c - 1)] - vd[static_cast<std::size_t>(c - 1)];
+      evaluations += 2;
+      const Eigen::VectorXd ru = scorer_.fit_residuals(simulator_.simulate(settings(effect, up[0], vu)));
+      const Eigen::VectorXd rd = scorer_.fit_residuals(simulator_.simulate(settings(effect, down[0], vd)));
+      jacobian.col(c) = std::abs(step) > 0 ? Eigen::VectorXd((ru - rd) / step) : Eigen::VectorXd::Zero(r0.size());
+    }
+    const double n = static_cast<double>(r0.size());
+    const double s2 = n > p ? r0.squaredNorm() / (n - p) : 0.0;
+    const Eigen::MatrixXd normal = jacobian.transpose() * jacobian;
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(normal, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    const Eigen::VectorXd sigma = svd.singularValues();
+    Eigen::VectorXd inverse_sigma = Eigen::VectorXd::Zero(sigma.size());
+    for (Eigen::Index i = 0; i < sigma.size(); ++i) {
+      if (sigma(i) > 1e-12 * sigma(0)) inverse_sigma(i) = 1.0 / sigma(i);
+    }
+    const Eigen::MatrixXd covariance = s2 * svd.matrixV() * inverse_sigma.asDiagonal() * svd.matrixU().transpose();
+    auto std_of = [&](int c) {
+      const double v = covariance(c, c);
+      bool identified = true;
+      for (Eigen::Index i = 0; i < sigma.size(); ++i) {
+        if (inverse_sigma(i) == 0.0 && std::abs(svd.matrixV()(c, i)) > 0.5) identified = false;
+      }
+      return identified && v >= 0 ? std::sqrt(v) : std::numeric_limits<double>::infinity();
+    };
+    f.beta_std = std_of(0);
+    for (int c = 1; c < p; ++c) f.std.push_back(std_of(c));
+    f.bic = n > 0 && f.score.fit_rss > 0 ? n * std::log(f.score.fit_rss / n) + p * std::log(n) : 0.0;
+    return f;
+  }
+
+  int evaluations = 0;
+
+ private:
+  const RecordingSimulator& simulator_;
+  const Scorer& scorer_;
+  const EffectContext& context_;
+};
+
+std::string id_list(const std::vector<int>& ids) {
+  std::ostringstream out;
+  for (std::size_t i = 0; i < ids.size();) {
+    std::size_t j = i;
+    while (j + 1 < ids.size() && ids[j + 1] == ids[j] + 1) ++j;
+    if (i > 0) out << ", ";
+    out << ids[i];
+    if (j > i) out << "-" << ids[j];
+    i = j + 1;
+    if (i >= 12 && i < ids.size()) {
+      out << " and " << ids.size() - i << " more";
+      break;
+    }
+  }
+  return out.str();
+}
+
+std::string number(double v) {
+  std::ostringstream out;
+  out.precision(3);
+  out << v;
+  return out.str();
+}
+
+std::vector<double> magnitudes(const Recording& recording, const std::vector<double>& simulated) {
+  return residual_magnitudes(make_residual_field(recording.positions, simulated, recording.particle_count, recording.dimension));
+}
+
+}  // namespace
+
+DiagnoseResult diagnose_recording(const Recording& recording, const DiagnoseOptions& options) {
+  const auto started = std::chrono::steady_clock::now();
+  if (options.model != "msm") {
+    throw std::runtime_error("model '" + options.model + "' is not available yet; use --model msm");
+  }
+  const int frames = recording.frame_count();
+  const int n = recording.particle_count;
+  const int dim = recording.dimension;
+  if (frames < kMinFrames) {
+    throw std::runtime_error("too few frames (" + std::to_string(frames) + "); diagnose needs at least " +
+                             std::to_string(kMinFrames));
+  }
+  auto report = [&](const std::string& stage, int done, int total) {
+    if (options.progress) options.progress(stage, done, total);
+  };
+
+  // Held-out blocks of about 0.1 s.
+  int block = options.holdout_block_frames;
+  if (block <= 0) {
+    const double duration = recording.frame_times_s.back() - recording.frame_times_s.front();
+    const double rate = duration > 0 ? (frames - 1) / duration : 30.0;
+    block = std::max(3, static_cast<int>(std::lround(0.1 * rate)));
+  }
+  std::vector<unsigned char> pairs = compared_pairs(recording);
+  long compared = 0;
+  for (unsigned char p : pairs) compared += p;
+  if (compared == 0) throw std::runtime_error("no particle is observed while free; nothing to compare the model with");
+  Scorer scorer(recording, pairs, interleaved_holdout(frames, block));
+
+  const double noise_std = estimate_noise_std(recording);
+  const double noise_rms = noise_std * std::sqrt(static_cast<double>(dim));
+
+  // Does anything move? Largest displacement of an observed particle from its first position.
+  double travel = 0;
+  for (int k = 0; k < frames; ++k) {
+    for (int i = 0; i < n; ++i) {
+      if (!recording.observed(k, i) || !recording.observed(0, i)) continue;
+      double squared = 0;
+      for (int d = 0; d < dim; ++d) {
+        const double step = recording.position(k, i, d) - recording.position(0, i, d);
+        squared += step * step;
+      }
+      travel = std::max(travel, std::sqrt(squared));
+    }
+  }
+  if (!(travel > 5.0 * std::max(noise_rms, 1e-12))) {
+    throw std::runtime_error("nothing moves beyond the measurement noise; there is no deformation to diagnose");
+  }
+
+  report("baseline", 0, 1);
+  const RecordingSimulator simulator(recording);
+  EffectContext context;
+  context.dimension = dim;
+  context.particle_count = n;
+  {
+    const std::vector<double>& rest = simulator.rest();
+    double size = 0;
+    for (int d = 0; d < dim; ++d) {
+      double lo = std::numeric_limits<double>::infinity();
+      double hi = -lo;
+      for (int i = 0; i < n; ++i) {
+        lo = std::min(lo, rest[static_cast<std::size_t>(i * dim + d)]);
+        hi = std::max(hi, rest[static_cast<std::size_t>(i * dim + d)]);
+      }
+      size = std::max(size, hi - lo);
+    }
+    context.object_size = size > 0 ? size : 1.0;
+    double normal_length = 0;
+    for (double v : simulator.support_normal()) normal_length += v * v;
+    context.has_support = normal_length > 0.5;
+  }
+  Fitter fitter(simulator, scorer, context);
+
+  // Baseline: msm_beta by a grid and golden section on the fitting frames.
+  double best_beta = 0.5;
+  double best_rss = std::numeric_limits<double>::infinity();
+  for (int i = 0; i <= 10; ++i) {
+    const double beta = i / 10.0;
+    const double rss = fitter.objective(nullptr, {beta});
+    if (rss < best_rss) {
+      best_rss = rss;
+      best_beta = beta;
+    }
+  }
+  golden([&](double beta) { return fitter.objective(nullptr, {beta}); }, std::max(0.0, best_beta - 0.1),
+         std::min(1.0, best_beta + 0.1), 1e-3, best_beta, best_rss);
+  const Fit baseline = fitter.finish(nullptr, {best_beta});
+  report("baseline", 1, 1);
+
+  DiagnoseResult result;
+  Diagnosis& out = result.diagnosis;
+  out.recording = recording.name;
+  out.noise_rms = noise_rms;
+  out.baseline.model = "msm";
+  out.baseline.parameters = {{"msm_alpha", 1.0}, {"msm_beta", baseline.beta}};
+  out.baseline.parameter_std = {{"msm_beta", baseline.beta_std}};
+  out.baseline.rms = baseline.score.held_rms();
+
+  // Locate.
+  const ResidualField field = make_residual_field(recording.positions, baseline.simulated, n, dim);
+  out.location = locate_mismatch(field, recording.frame_times_s, noise_std);
+  context.located = out.location.particles;
+  const std::map<std::string, double> signatures =
+      residual_signatures(recording, baseline.simulated, field, out.location, noise_std);
+
+  // Candidates.
+  const double misfit = noise_rms > 0 ? out.baseline.rms / noise_rms : std::numeric_limits<double>::infinity();
+  const std::vector<Effect> effects = effect_catalogue(context);
+  std::vector<Fit> fits;
+  for (std::size_t e = 0; e < effects.size(); ++e) {
+    report("effects", static_cast<int>(e), static_cast<int>(effects.size()));
+    fits.push_back(fitter.fit(&effects[e], baseline.beta));
+  }
+  report("effects", static_cast<int>(effects.size()), static_cast<int>(effects.size()));
+
+  struct Ranked {
+    std::size_t index;
+    double significance;
+    bool passes;
+  };
+  std::vector<Ranked> ranked;
+  for (std::size_t e = 0; e < effects.size(); ++e) {
+    const Fit& f = fits[e];
+    double significance = 0;
+    for (std::size_t p = 0; p < f.values.size(); ++p) {
+      const EffectParameter& parameter = effects[e].parameters[p];
+      const double null_value = parameter.name == "region_msm_beta" ? f.beta : parameter.null_value;
+      if (std::isfinite(f.std[p]) && f.std[p] > 0) {
+        significance = std::max(significance, std::abs(f.values[p] - null_value) / f.std[p]);
+      }
+    }
+    const double improvement = out.baseline.rms > 0 ? 1.0 - f.score.held_rms() / out.baseline.rms : 0.0;
+    const bool passes = misfit >= kMinMisfit && improvement >= kMinImprovement && baseline.bic - f.bic >= kMinBicGain &&
+                        significance >= kMinSignificance;
+    ranked.push_back({e, significance, passes});
+  }
+  std::sort(ranked.begin(), ranked.end(), [&](const Ranked& a, const Ranked& b) {
+    if (a.passes != b.passes) return a.passes;
+    return fits[a.index].score.held_rms() < fits[b.index].score.held_rms();
+  });
+  for (const Ranked& r : ranked) {
+    const Fit& f = fits[r.index];
+    Candidate c;
+    c.effect = effects[r.index].name;
+    for (std::size_t p = 0; p < f.values.size(); ++p) {
+      c.parameters[effects[r.index].parameters[p].name] = f.values[p];
+      c.parameter_std[effects[r.index].parameters[p].name] = f.std[p];
+    }
+    c.parameters["msm_beta"] = f.beta;
+    c.parameter_std["msm_beta"] = f.beta_std;
+    c.rms = f.score.held_rms();
+    c.bic = f.bic;
+    out.candidates.push_back(c);
+  }
+
+  const bool found = !ranked.empty() && ranked.front().passes;
+  const std::vector<double> baseline_map = magnitudes(recording, baseline.simulated);
+  const double t0 = out.location.t_start;
+  const double t1 = out.location.t_end;
+  std::ostringstream where;
+  if (!out.location.particles.empty()) {
+    where << "particles " << id_list(out.location.particles) << " between t = " << number(t0) << " s and " << number(t1)
+          << " s";
+  }
+  if (found) {
+    const Ranked& best = ranked.front();
+    const Effect& effect = effects[best.index];
+    const Fit& f = fits[best.index];
+    out.verdict = "missing_physics";
+    out.effect = effect.name;
+    out.augmented.model = "msm";
+    out.augmented.parameters = out.candidates.front().parameters;
+    out.augmented.parameter_std = out.candidates.front().parameter_std;
+    out.augmented.parameters["msm_alpha"] = 1.0;
+    out.augmented.rms = f.score.held_rms();
+    out.improvement = 1.0 - out.augmented.rms / out.baseline.rms;
+    std::ostringstream text;
+    text << "The elastic model misses " << (where.str().empty() ? std::string("the motion") : where.str())
+         << " by " << number(out.baseline.rms) << " " << recording.length_unit << " rms (noise " << number(noise_rms)
+         << "); " << effect.physics << " explains it, cutting the held-out rms by " << number(100.0 * out.improvement)
+         << " % and moving msm_beta from " << number(baseline.beta) << " to " << number(f.beta) << ".";
+    if (ranked.size() > 1 && ranked[1].passes && fits[ranked[1].index].bic - f.bic < 6.0) {
+      text << " " << effects[ranked[1].index].name << " fits almost as well; " << effect.experiment << ".";
+    }
+    out.explanation = text.str();
+    result.evidence.simulated_augmented = f.simulated;
+  } else {
+    out.augmented = out.baseline;
+    out.improvement = 0;
+    if (misfit >= kUnknownMisfit && !out.location.particles.empty()) {
+      out.verdict = "missing_physics";
+      out.effect = "unknown";
+      out.explanation = "The elastic model misses " + where.str() + " by " + number(out.baseline.rms) + " " +
+                        recording.length_unit + " rms, " + number(misfit) +
+                        " times the noise, and no catalogued effect explains it clearly.";
+    } else {
+      out.verdict = "consistent";
+      out.effect = "none";
+      out.explanation = "The elastic model explains the recording to within " + number(misfit) +
+                        " times the measurement noise on held-out frames; no added physics improves it clearly.";
+    }
+    result.evidence.simulated_augmented = baseline.simulated;
+  }
+
+  DiagnosisEvidence& ev = result.evidence;
+  ev.dimension = dim;
+  ev.particle_count = n;
+  ev.length_unit = recording.length_unit;
+  ev.frame_times_s = recording.frame_times_s;
+  ev.held_out = scorer.held_out();
+  ev.observed = recording.positions;
+  ev.simulated_baseline = baseline.simulated;
+  ev.residual_baseline = baseline_map;
+  ev.residual_augmented = magnitudes(recording, ev.simulated_augmented);
+  ev.fixed = recording.fixed;
+  for (const DrivenWindow& w : recording.driven) ev.driven.push_back(w.id);
+  std::sort(ev.driven.begin(), ev.driven.end());
+  ev.driven.erase(std::unique(ev.driven.begin(), ev.driven.end()), ev.driven.end());
+  ev.signatures = signatures;
+  ev.signatures["misfit_over_noise"] = misfit;
+  ev.signatures["simulations"] = fitter.evaluations;
+  result.runtime_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return result;
+}
+
+nlohmann::json diagnosis_json(const Diagnosis& d) {
+  auto model = [](const FittedModel& m) {
+    return nlohmann::json{{"model", m.model}, {"parameters", m.parameters}, {"rms", m.rms}};
+  };
+  nlohmann::json candidates = nlohmann::json::array();
+  for (const Candidate& c : d.candidates) {
+    candidates.push_back({{"effect", c.effect}, {"rms", c.rms}, {"bic", c.bic}, {"parameters", c.parameters}});
+  }
+  return {{"format", "pliant-diagnosis"},
+          {"version", 1},
+          {"recording", d.recording},
+          {"baseline", model(d.baseline)},
+          {"noise_rms", d.noise_rms},
+          {"verdict", d.verdict},
+          {"effect", d.effect},
+          {"explanation", d.explanation},
+          {"location", {{"particles", d.location.particles}, {"t_start", d.location.t_start}, {"t_end", d.location.t_end}}},
+          {"augmented", model(d.augmented)},
+          {"improvement", d.improvement},
+          {"candidates", candidates}};
+}
+
+std::string diagnosis_summary(const Diagnosis& d, const std::string& length_unit) {
+  std::ostringstream out;
+  out << d.recording << ": " << d.verdict;
+  if (d.effect != "none") out << " (" << d.effect << ")";
+  out << "\n  baseline msm_beta " << number(d.baseline.parameters.at("msm_beta")) << ", held-out rms "
+      << number(d.baseline.rms) << " " << length_unit << ", noise " << number(d.noise_rms) << " " << length_unit << "\n";
+  if (d.verdict == "missing_physics" && d.effect != "unknown") {
+    out << "  with " << d.effect << ": held-out rms " << number(d.augmented.rms) << " " << length_unit
+        << " (improvement " << number(100.0 * d.improvement) << " %)\n";
+  }
+  out << "  " << d.explanation << "\n";
+  return out.str();
+}
+
+}  // namespace pliant::host
