@@ -45,8 +45,10 @@ std::string number(double value) {
 
 SimulateCommand::SimulateCommand(CLI::App& parent) {
   app_ = parent.add_subcommand("simulate", "Write a simulated recording with known msm_beta (and its truth.json)");
-  app_->footer("Scenarios: " + joined(host::scenario_names()) +
-               ". truth.json holds the true parameters for checking; no estimator reads it.");
+  app_->footer("Scenarios: " + joined(host::scenario_names()) + ".\nEffects for --effect, with their defaults: " +
+               host::describe_effects() +
+               ".\nThe recording never mentions the effect, the substeps, the cluster radius or the occlusion; "
+               "truth.json holds them with the true parameters, for checking. No estimator reads it.");
   app_->add_option("SCENARIO", scenario_, "One of: " + joined(host::scenario_names()))->required();
   app_->add_option("-o,--output", output_, "Recording directory to write (created if missing)")
       ->type_name("DIR")
@@ -66,6 +68,29 @@ SimulateCommand::SimulateCommand(CLI::App& parent) {
       ->capture_default_str();
   app_->add_option("--rate", options_.rate_hz, "Frames per second (default: the scenario's own rate)")
       ->type_name("HZ");
+  // Parsed in run(), where a bad name becomes a usage error naming the valid ones.
+  app_->add_option("--effect", options_.effect,
+                   "Concealed effect switched on in the simulation, with optional parameters, e.g. "
+                   "plasticity:yield=0.02,creep=4 or heterogeneity:ratio=0.3,region=left")
+      ->type_name("NAME[:P=V,...]");
+  app_->add_option("--substeps", options_.substeps, "MSM steps per frame interval, 1..64 (estimators fit 1)")
+      ->type_name("N")
+      ->capture_default_str();
+  app_->add_option("--cluster-radius", options_.cluster_radius_factor,
+                   "Generator's cluster radius / median neighbour distance, in [1, 4] (estimators use 1.5)")
+      ->type_name("F")
+      ->capture_default_str();
+  app_->add_option("--occlusion", options_.occlusion,
+                   "Share of (particle, frame) observations removed in runs of frames, in [0, 0.5]; never frame 0 "
+                   "nor the driven particle while driven")
+      ->type_name("F")
+      ->capture_default_str();
+  app_->add_option("--depth", options_.depth,
+                   "Tool travel as a fraction of the object's height, in (0, 2] (default: the scenario's own)")
+      ->type_name("F");
+  app_->add_flag("--release", options_.release,
+                 "foam_press, block_press: the tool lets go after the hold and 1.5 s more are recorded "
+                 "(the other scenarios always release)");
   app_->add_flag("--force", force_, "Write into a non-empty DIR, replacing files of the same names");
 }
 
@@ -73,17 +98,22 @@ int SimulateCommand::run() const {
   // The library reads rate 0 as "the scenario's own rate"; on the command line that is leaving it out.
   if (app_->count("--rate") > 0 && !(options_.rate_hz > 0.0)) throw UsageError("--rate must be > 0");
   if (options_.rate_hz > max_rate_hz) throw UsageError("--rate must be at most " + number(max_rate_hz));
+  // Depth 0 likewise means the scenario's own depth.
+  if (app_->count("--depth") > 0 && !(options_.depth > 0.0)) throw UsageError("--depth must be in (0, 2]");
+  host::ScenarioOptions options = options_;
   check_output_directory(output_, force_);
   host::ScenarioResult scenario;
   try {
-    scenario = host::make_scenario(scenario_, options_);
+    if (app_->count("--effect") > 0) host::parse_effect_argument(options_.effect, options);
+    scenario = host::make_scenario(scenario_, options);
   } catch (const std::invalid_argument& e) {
-    // make_scenario validates the scenario name and the option values.
+    // make_scenario validates the scenario name, the option values and the effect.
     throw UsageError(e.what());
   }
   host::write_scenario(scenario, output_);
 
   const host::Recording& rec = scenario.recording;
+  // The summary names what is visible in the recording; the effect stays in truth.json.
   std::cout << "wrote " << output_ << ": " << scenario_ << ", " << rec.particle_count << " particles x "
             << rec.frame_count() << " frames (" << rec.dimension << "D, " << rec.length_unit
             << "), msm_beta " << number(options_.msm_beta) << ", msm_alpha " << number(options_.msm_alpha)

@@ -70,6 +70,17 @@ TEST(cli_simulate, BadValuesExitTwoWithOneLineAndWriteNothing) {
       {"foam_press --rate 0", "--rate"},     {"foam_press --rate 1e9", "--rate"},
       {"foam_press --seed -3", "--seed"},    {"foam_press --beta soft", "--beta"},
       {"jelly_wobble", "jelly_wobble"},
+      {"foam_press --effect plastic", "plasticity, viscosity, friction, gravity, heterogeneity, stiffening"},
+      {"foam_press --effect plasticity:foo=1", "yield, creep, max"},
+      {"foam_press --effect plasticity:yield", "param=value"},
+      {"foam_press --effect heterogeneity:region=middle", "inclusion, left, right"},
+      {"foam_press --effect gravity:g=-2", "g must be >= 0"},
+      {"foam_press --effect viscosity:tau=0", "tau"},
+      {"foam_press --effect ''", "--effect"},
+      {"foam_press --substeps 0", "--substeps"},  {"foam_press --substeps 100", "--substeps"},
+      {"foam_press --cluster-radius 0.5", "--cluster-radius"},
+      {"foam_press --occlusion 0.8", "--occlusion"}, {"foam_press --occlusion -0.1", "--occlusion"},
+      {"foam_press --depth 0", "--depth"},       {"foam_press --depth 3", "--depth"},
   };
   for (const BadValue& c : cases) {
     TempDir dir;
@@ -80,6 +91,50 @@ TEST(cli_simulate, BadValuesExitTwoWithOneLineAndWriteNothing) {
     EXPECT_EQ(r.err.rfind("pliant simulate: ", 0), 0u) << r.err;
     EXPECT_TRUE(contains(r.err, c.mentions)) << c.arguments << ": " << r.err;
     EXPECT_FALSE(fs::exists(out)) << c.arguments;
+  }
+}
+
+TEST(cli_simulate, ConcealedEffectLeavesNoTraceInTheRecording) {
+  TempDir dir;
+  const std::string out = dir / "case";
+  const CommandResult r = run_pliant("simulate cantilever_strip -o " + quoted(out) +
+                                     " --effect gravity:g=0.02 --substeps 2 --cluster-radius 1.8 --occlusion 0.1"
+                                     " --noise 0.005 --seed 3");
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const std::string word : {"effect", "gravity", "substeps", "occlusion", "1.8"}) {
+    EXPECT_FALSE(contains(r.out, word)) << r.out;
+  }
+  const std::string json = read_text(fs::path(out) / "recording.json");
+  const std::string csv = read_text(fs::path(out) / "particles.csv");
+  for (const std::string word : {"effect", "gravity"}) {
+    EXPECT_FALSE(contains(json, word)) << json;
+    EXPECT_FALSE(contains(csv, word));
+  }
+  const nlohmann::json truth = nlohmann::json::parse(read_text(fs::path(out) / "truth.json"));
+  EXPECT_EQ(truth.at("effect").get<std::string>(), "gravity");
+  EXPECT_DOUBLE_EQ(truth.at("effect_parameters").at("g").get<double>(), 0.02);
+  EXPECT_EQ(truth.at("steps_per_frame").get<int>(), 2);
+  EXPECT_DOUBLE_EQ(truth.at("cluster_radius_factor").get<double>(), 1.8);
+  EXPECT_DOUBLE_EQ(truth.at("occlusion").get<double>(), 0.1);
+  EXPECT_GT(truth.at("occluded_observations").get<int>(), 0);
+
+  // Missing rows, and the recording still reads: estimate accepts it.
+  const CommandResult estimate = run_pliant("estimate " + quoted(out));
+  EXPECT_EQ(estimate.status, 0) << estimate.err;
+}
+
+TEST(cli_simulate, NewScenariosAndReleaseWriteDrivenWindowsThatEnd) {
+  for (const std::string arguments : {"ring_squeeze", "dome_press", "foam_press --release --depth 0.1",
+                                      "block_press --release"}) {
+    TempDir dir;
+    const std::string out = dir / "rec";
+    const CommandResult r = run_pliant("simulate " + arguments + " -o " + quoted(out));
+    ASSERT_EQ(r.status, 0) << arguments << ": " << r.err;
+    const nlohmann::json json = nlohmann::json::parse(read_text(fs::path(out) / "recording.json"));
+    const nlohmann::json& driven = json.at("particles").at("driven");
+    ASSERT_EQ(driven.size(), 1u) << arguments;
+    EXPECT_TRUE(driven[0].contains("to")) << arguments << ": " << driven.dump();
+    EXPECT_FALSE(json.at("particles").at("fixed").empty()) << arguments;
   }
 }
 

@@ -15,7 +15,8 @@ constexpr double kNoiseFloor = 1e-9;     // noise-free input: this fraction of t
 constexpr double kSignificance = 3.0;    // z for every "significant" test of the signatures
 constexpr int kRestFrames = 5;           // frames averaged for a driver's final position
 constexpr int kSupportRestFrames = 10;   // frames averaged for a support particle's rest
-constexpr double kSupportSignificance = 4.0;  // skewed statistic: 3e-4 false alarms on noise
+// Gate for pooled mean squares of few samples (skewed, chi-square-like): 4 standard deviations.
+constexpr double kSmallSampleSignificance = 4.0;
 constexpr double kTailFraction = 0.2;    // persistence: last 20% of the frames after unloading
 constexpr int kVelocityHalfWindow = 2;   // velocities: slope over 5 frames
 constexpr int kPeakHalfWindow = 2;       // persistence: peak of a 5-frame pooled mean square
@@ -346,7 +347,7 @@ double persistence_after_unload(const Recording& recording, const ResidualField&
   }
   if (!(pairs > 0)) return 0.0;
   const double tail_ms = sum / pairs;
-  if (!clearly_above(tail_ms, pairs, dim, noise, 1.0, gate.z)) return 0.0;
+  if (!clearly_above(tail_ms, pairs, dim, noise, 1.0, kSmallSampleSignificance)) return 0.0;
   return std::clamp(std::sqrt((tail_ms - noise_ms) / peak), 0.0, 1.0);
 }
 
@@ -466,7 +467,7 @@ double support_motion(const Recording& recording, double noise_std) {
     const double share = samples / count;
     variance += share * share * 2.0 * dim * noise4 / (m * m) + 4.0 * samples * dim * noise4 / (m * count * count);
   }
-  if (!(ms > expected_ms + kSupportSignificance * std::sqrt(variance))) return 0.0;
+  if (!(ms > expected_ms + kSmallSampleSignificance * std::sqrt(variance))) return 0.0;
   return std::sqrt(ms - expected_ms) / std::sqrt(noise_ms);
 }
 

@@ -53,8 +53,8 @@ Location locate_mismatch(const ResidualField& field, const std::vector<double>& 
 /// Excess rms of the located particles over the last 20% of the frames after unloading,
 /// divided by their peak excess rms (the largest mean square pooled over 5 consecutive
 /// frames); in [0, 1] (1: the residual does not decay after unloading). Excess rms =
-/// sqrt(mean square - dim * noise^2), counted only when clearly above noise (the tail: z-test
-/// only). Unloading frame = the latest over driven particles of (a) the frame after the
+/// sqrt(mean square - dim * noise^2), counted only when clearly above noise (the tail: only
+/// the z-test, with z = 4). Unloading frame = the latest over driven particles of (a) the frame after the
 /// particle last differs from its final driven position by more than
 /// max(3 * noise * sqrt(dim), 1% of its travel) and (b) the frame after its driven window
 /// ends, when it ends inside the recording. No driven particle: the last 20% of the recording.
