@@ -406,7 +406,7 @@ TYPED_TEST_SUITE(RealTimeAllocation, Cases, CaseNames);
 void count_progress(void* context, int, int) { ++*static_cast<int*>(context); }
 
 // msm_step with every feature on: two driven targets moving, external forces, gravity,
-// damping, plasticity and per-cluster beta.
+// damping, plasticity, relaxation, stiffening, support friction and per-cluster beta.
 TYPED_TEST(RealTimeAllocation, MsmStepWithAllFeatures) {
   using Scalar = typename TestFixture::FixtureScalar;
   using Vec = typename TestFixture::FixtureVec;
@@ -430,6 +430,12 @@ TYPED_TEST(RealTimeAllocation, MsmStepWithAllFeatures) {
   params.plastic_yield = Scalar(0.01);
   params.plastic_creep = Scalar(5);
   params.plastic_max = Scalar(0.5);
+  params.relaxation_fraction = Scalar(0.3);
+  params.relaxation_time_s = Scalar(0.5);
+  params.stiffening = Scalar(5);
+  params.support_friction = Scalar(0.4);
+  params.support_normal = Vec::Zero();
+  params.support_normal(Dim - 1) = Scalar(1);
 
   std::vector<Vec> forces(static_cast<std::size_t>(scene.n), Vec::Zero());
   for (int i = 0; i < scene.n; ++i) forces[static_cast<std::size_t>(i)](0) = static_cast<Scalar>(0.01 * (i % 3));
@@ -471,6 +477,11 @@ TYPED_TEST(RealTimeAllocation, MsmStepWithAllFeatures) {
     if (!state.plastic[c].isIdentity(Scalar(1e-4))) yielded = true;
   }
   EXPECT_TRUE(yielded) << "plasticity never engaged; the test does not cover update_plastic";
+  bool relaxed = false;
+  for (int c = 0; c < scene.model.cluster_count; ++c) {
+    if (!state.relaxed[c].isIdentity(Scalar(1e-6))) relaxed = true;
+  }
+  EXPECT_TRUE(relaxed) << "relaxation never engaged";
 }
 
 TYPED_TEST(RealTimeAllocation, MsmStateReset) {
