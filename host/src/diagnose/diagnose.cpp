@@ -167,54 +167,150 @@ class Fitter {
     return scorer_.score(sim).fit_rss;
   }
 
-  // Coordinate search: a coarse scan then golden section per coordinate, two sweeps.
+  // Fitting-frame residuals at search coordinates u (one simulation).
+  Eigen::VectorXd residuals(const Effect* effect, const std::vector<double>& u) {
+    ++evaluations;
+    return scorer_.fit_residuals(simulator_.simulate(settings(effect, u[0], physical(effect, u))));
+  }
+
+  // The fit: a grid over the effect's scanned coordinates (responses flat near the null need
+  // it), msm_beta profiled out at every grid point by Gauss-Newton (it trades off against
+  // most effects), then bounded Levenberg-Marquardt on all coordinates from the two best grid
+  // points.
   Fit fit(const Effect* effect, double start_beta) {
-    std::vector<double> u(1, start_beta);
-    if (effect != nullptr) {
-      for (const EffectParameter& p : effect->parameters) {
-        double start = 0.0;
-        if (p.name == "region_msm_beta") start = start_beta;
-        else if (p.lower < p.null_value && p.null_value < p.upper) start = (p.null_value - p.lower) / (p.upper - p.lower);
-        u.push_back(start);
+    std::vector<double> start(1, start_beta);
+    std::vector<int> scanned;
+    for (std::size_t p = 0; p < effect->parameters.size(); ++p) {
+      const EffectParameter& parameter = effect->parameters[p];
+      double u = 0.0;
+      if (std::isfinite(parameter.null_value)) u = parameter.coordinate(parameter.null_value);
+      else if (effect->replaces_beta) u = parameter.coordinate(start_beta);
+      start.push_back(u);
+      if (parameter.scanned) scanned.push_back(static_cast<int>(p) + 1);
+    }
+    const bool fit_beta = !effect->replaces_beta;
+
+    struct Seed {
+      std::vector<double> u;
+      double cost;
+    };
+    std::vector<Seed> seeds;
+    const int per_axis = scanned.size() <= 1 ? 7 : (scanned.size() == 2 ? 5 : 4);
+    long points = 1;
+    for (std::size_t a = 0; a < scanned.size(); ++a) points *= per_axis;
+    for (long index = 0; index < points; ++index) {
+      std::vector<double> u = start;
+      long rest = index;
+      for (int c : scanned) {
+        u[static_cast<std::size_t>(c)] = static_cast<double>(rest % per_axis) / (per_axis - 1);
+        rest /= per_axis;
+      }
+      const double cost = fit_beta ? profile_beta(effect, u) : residuals(effect, u).squaredNorm();
+      seeds.push_back({u, cost});
+    }
+    std::sort(seeds.begin(), seeds.end(), [](const Seed& a, const Seed& b) { return a.cost < b.cost; });
+    std::vector<double> best_u = seeds.front().u;
+    double best_cost = std::numeric_limits<double>::infinity();
+    const std::size_t starts = std::min<std::size_t>(seeds.size(), 2);
+    for (std::size_t k = 0; k < starts; ++k) {
+      std::vector<double> u = seeds[k].u;
+      const double cost = levenberg_marquardt(effect, u, fit_beta);
+      if (cost < best_cost) {
+        best_cost = cost;
+        best_u = u;
       }
     }
-    double best = objective(effect, u);
-    const int coordinates = static_cast<int>(u.size());
-    for (int sweep = 0; sweep < 2; ++sweep) {
-      for (int c = coordinates - 1; c >= 0; --c) {
-        const bool is_beta = c == 0;
-        const auto along = [&](double x) {
-          std::vector<double> trial = u;
-          trial[static_cast<std::size_t>(c)] = x;
-          return objective(effect, trial);
-        };
-        double best_x = u[static_cast<std::size_t>(c)];
-        double lo = 0;
-        double hi = 1;
-        if (sweep == 0 && !is_beta) {
-          // Scan: effect parameters can be flat near their null (a yield above every strain).
-          constexpr int kScan = 6;
-          for (int i = 0; i < kScan; ++i) {
-            const double x = static_cast<double>(i) / (kScan - 1);
-            const double v = along(x);
-            if (v < best) {
-              best = v;
-              best_x = x;
-            }
-          }
-          lo = std::max(0.0, best_x - 0.2);
-          hi = std::min(1.0, best_x + 0.2);
-        } else {
-          const double half = is_beta ? (sweep == 0 ? 0.15 : 0.05) : 0.1;
-          lo = std::max(0.0, best_x - half);
-          hi = std::min(1.0, best_x + half);
+    return finish(effect, best_u);
+  }
+
+  // msm_beta (coordinate 0) refitted with the others held: two Gauss-Newton steps.
+  double profile_beta(const Effect* effect, std::vector<double>& u) {
+    Eigen::VectorXd r = residuals(effect, u);
+    double cost = r.squaredNorm();
+    for (int iteration = 0; iteration < 2; ++iteration) {
+      const double h = u[0] + 0.01 <= 1.0 ? 0.01 : -0.01;
+      std::vector<double> probe = u;
+      probe[0] += h;
+      const Eigen::VectorXd j = (residuals(effect, probe) - r) / h;
+      const double jj = j.squaredNorm();
+      if (!(jj > 0)) break;
+      const double step = std::clamp(-j.dot(r) / jj, -0.3, 0.3);
+      std::vector<double> trial = u;
+      trial[0] = std::clamp(u[0] + step, 0.0, 1.0);
+      const Eigen::VectorXd rt = residuals(effect, trial);
+      const double ct = rt.squaredNorm();
+      if (!(ct < cost)) break;
+      u = trial;
+      r = rt;
+      cost = ct;
+    }
+    return cost;
+  }
+
+  // Bounded Levenberg-Marquardt in the unit coordinates: forward-difference Jacobian, bounds by
+  // projection, coordinates held at a bound while the gradient pushes outward. Returns the
+  // fitting-frame residual sum of squares at the final u.
+  double levenberg_marquardt(const Effect* effect, std::vector<double>& u, bool fit_beta) {
+    const int p = static_cast<int>(u.size());
+    Eigen::VectorXd r = residuals(effect, u);
+    double cost = r.squaredNorm();
+    double lambda = 1e-2;
+    for (int iteration = 0; iteration < 25; ++iteration) {
+      Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(r.size(), p);
+      for (int c = fit_beta ? 0 : 1; c < p; ++c) {
+        const double h = u[static_cast<std::size_t>(c)] + 0.005 <= 1.0 ? 0.005 : -0.005;
+        std::vector<double> probe = u;
+        probe[static_cast<std::size_t>(c)] += h;
+        jacobian.col(c) = (residuals(effect, probe) - r) / h;
+      }
+      const Eigen::VectorXd gradient = jacobian.transpose() * r;
+      std::vector<int> free;
+      for (int c = fit_beta ? 0 : 1; c < p; ++c) {
+        const double uc = u[static_cast<std::size_t>(c)];
+        const double gc = gradient(c);
+        if ((uc <= 0.0 && gc > 0) || (uc >= 1.0 && gc < 0)) continue;
+        if (jacobian.col(c).squaredNorm() > 0) free.push_back(c);
+      }
+      if (free.empty()) break;
+      const int m = static_cast<int>(free.size());
+      Eigen::MatrixXd normal(m, m);
+      Eigen::VectorXd g(m);
+      for (int a = 0; a < m; ++a) {
+        g(a) = gradient(free[static_cast<std::size_t>(a)]);
+        for (int b = 0; b < m; ++b) {
+          normal(a, b) = jacobian.col(free[static_cast<std::size_t>(a)]).dot(jacobian.col(free[static_cast<std::size_t>(b)]));
         }
-        golden(along, lo, hi, is_beta ? 2e-3 : 1e-2, best_x, best);
-        u[static_cast<std::size_t>(c)] = best_x;
       }
-      if (effect == nullptr) break;
+      bool accepted = false;
+      double new_cost = cost;
+      for (int attempt = 0; attempt < 8 && !accepted; ++attempt) {
+        Eigen::MatrixXd damped = normal;
+        for (int a = 0; a < m; ++a) damped(a, a) += lambda * std::max(normal(a, a), 1e-12);
+        const Eigen::VectorXd delta = damped.ldlt().solve(-g);
+        std::vector<double> trial = u;
+        for (int a = 0; a < m; ++a) {
+          double& value = trial[static_cast<std::size_t>(free[static_cast<std::size_t>(a)])];
+          value = std::clamp(value + (std::isfinite(delta(a)) ? delta(a) : 0.0), 0.0, 1.0);
+        }
+        if (trial == u) break;
+        const Eigen::VectorXd rt = residuals(effect, trial);
+        const double ct = rt.squaredNorm();
+        if (ct < cost) {
+          accepted = true;
+          new_cost = ct;
+          u = trial;
+          r = rt;
+          lambda = std::max(lambda / 4.0, 1e-7);
+        } else {
+          lambda *= 6.0;
+        }
+      }
+      if (!accepted) break;
+      const double gain = cost - new_cost;
+      cost = new_cost;
+      if (gain < 1e-5 * cost) break;
     }
-    return finish(effect, u);
+    return cost;
   }
 
   Fit finish(const Effect* effect, const std::vector<double>& u) {
@@ -227,8 +323,9 @@ class Fitter {
     // Uncertainty: J = d residual / d parameter by central differences; cov = s^2 (J^T J)^-1.
     const Eigen::VectorXd r0 = scorer_.fit_residuals(f.simulated);
     const int p = static_cast<int>(u.size());
-    Eigen::MatrixXd jacobian(r0.size(), p);
-    for (int c = 0; c < p; ++c) {
+    const int first = effect != nullptr && effect->replaces_beta ? 1 : 0;
+    Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(r0.size(), p);
+    for (int c = first; c < p; ++c) {
       const double h = 0.01;
       std::vector<double> up = u;
       std::vector<double> down = u;
@@ -242,19 +339,20 @@ class Fitter {
       const Eigen::VectorXd rd = scorer_.fit_residuals(simulator_.simulate(settings(effect, down[0], vd)));
       jacobian.col(c) = std::abs(step) > 0 ? Eigen::VectorXd((ru - rd) / step) : Eigen::VectorXd::Zero(r0.size());
     }
+    const int fitted = p - first;
     const double n = static_cast<double>(r0.size());
-    const double s2 = n > p ? r0.squaredNorm() / (n - p) : 0.0;
+    const double s2 = n > fitted ? r0.squaredNorm() / (n - fitted) : 0.0;
     const Eigen::MatrixXd normal = jacobian.transpose() * jacobian;
     Eigen::JacobiSVD<Eigen::MatrixXd> svd(normal, Eigen::ComputeFullU | Eigen::ComputeFullV);
     const Eigen::VectorXd sigma = svd.singularValues();
     Eigen::VectorXd inverse_sigma = Eigen::VectorXd::Zero(sigma.size());
     for (Eigen::Index i = 0; i < sigma.size(); ++i) {
-      if (sigma(i) > 1e-12 * sigma(0)) inverse_sigma(i) = 1.0 / sigma(i);
+      if (sigma(0) > 0 && sigma(i) > 1e-12 * sigma(0)) inverse_sigma(i) = 1.0 / sigma(i);
     }
     const Eigen::MatrixXd covariance = s2 * svd.matrixV() * inverse_sigma.asDiagonal() * svd.matrixU().transpose();
     auto std_of = [&](int c) {
       const double v = covariance(c, c);
-      bool identified = true;
+      bool identified = jacobian.col(c).squaredNorm() > 0;
       for (Eigen::Index i = 0; i < sigma.size(); ++i) {
         if (inverse_sigma(i) == 0.0 && std::abs(svd.matrixV()(c, i)) > 0.5) identified = false;
       }
@@ -262,7 +360,24 @@ class Fitter {
     };
     f.beta_std = std_of(0);
     for (int c = 1; c < p; ++c) f.std.push_back(std_of(c));
-    f.bic = n > 0 && f.score.fit_rss > 0 ? n * std::log(f.score.fit_rss / n) + p * std::log(n) : 0.0;
+    if (first == 1) {
+      // Per-patch stiffness: report the bulk msm_beta (the particle-weighted median patch).
+      std::vector<std::pair<double, std::size_t>> by_beta;
+      for (std::size_t k = 0; k < context_.patches.size(); ++k) by_beta.push_back({f.values[k], context_.patches[k].size()});
+      std::sort(by_beta.begin(), by_beta.end());
+      std::size_t total = 0;
+      for (const auto& b : by_beta) total += b.second;
+      std::size_t seen = 0;
+      for (const auto& b : by_beta) {
+        seen += b.second;
+        if (2 * seen >= total) {
+          f.beta = b.first;
+          break;
+        }
+      }
+      f.beta_std = std::numeric_limits<double>::infinity();
+    }
+    f.bic = n > 0 && f.score.fit_rss > 0 ? n * std::log(f.score.fit_rss / n) + fitted * std::log(n) : 0.0;
     return f;
   }
 
@@ -406,6 +521,7 @@ DiagnoseResult diagnose_recording(const Recording& recording, const DiagnoseOpti
   const ResidualField field = make_residual_field(recording.positions, baseline.simulated, n, dim);
   out.location = locate_mismatch(field, recording.frame_times_s, noise_std);
   context.located = out.location.particles;
+  context.patches = spatial_patches(simulator.rest(), dim, std::max(6, n / 8));
   const std::map<std::string, double> signatures =
       residual_signatures(recording, baseline.simulated, field, out.location, noise_std);
 
@@ -430,8 +546,9 @@ DiagnoseResult diagnose_recording(const Recording& recording, const DiagnoseOpti
     double significance = 0;
     for (std::size_t p = 0; p < f.values.size(); ++p) {
       const EffectParameter& parameter = effects[e].parameters[p];
-      const double null_value = parameter.name == "region_msm_beta" ? f.beta : parameter.null_value;
-      if (std::isfinite(f.std[p]) && f.std[p] > 0) {
+      // A per-patch stiffness is tested against the bulk msm_beta, others against their null.
+      const double null_value = effects[e].replaces_beta ? f.beta : parameter.null_value;
+      if (std::isfinite(null_value) && std::isfinite(f.std[p]) && f.std[p] > 0) {
         significance = std::max(significance, std::abs(f.values[p] - null_value) / f.std[p]);
       }
     }

@@ -85,17 +85,18 @@ struct SimulatorImpl {
       for (int d = 0; d < Dim; ++d) params.support_normal(d) = normal[static_cast<std::size_t>(d)];
     }
     std::vector<double> cluster_beta;
-    if (!settings.region.empty() && settings.region_beta >= 0) {
-      // A cluster belongs to the region when most of its members do.
-      std::vector<unsigned char> inside(static_cast<std::size_t>(n), 0);
-      for (int id : settings.region) inside[static_cast<std::size_t>(id)] = 1;
+    if (!settings.particle_beta.empty()) {
+      if (static_cast<int>(settings.particle_beta.size()) != n) {
+        throw std::runtime_error("particle_beta needs one value per particle");
+      }
       cluster_beta.assign(static_cast<std::size_t>(m.cluster_count), settings.msm_beta);
       for (int c = 0; c < m.cluster_count; ++c) {
-        int members_inside = 0;
-        for (int k = m.cluster_begin[c]; k < m.cluster_begin[c + 1]; ++k) members_inside += inside[static_cast<std::size_t>(m.members[k])];
-        if (2 * members_inside > m.cluster_begin[c + 1] - m.cluster_begin[c]) {
-          cluster_beta[static_cast<std::size_t>(c)] = settings.region_beta;
+        double sum = 0;
+        for (int k = m.cluster_begin[c]; k < m.cluster_begin[c + 1]; ++k) {
+          sum += settings.particle_beta[static_cast<std::size_t>(m.members[k])];
         }
+        const int members = m.cluster_begin[c + 1] - m.cluster_begin[c];
+        if (members > 0) cluster_beta[static_cast<std::size_t>(c)] = std::clamp(sum / members, 0.0, 1.0);
       }
       params.cluster_beta = cluster_beta.data();
     }

@@ -29,8 +29,9 @@ struct ModelSettings {
   double relaxation_time_s = 1;
   double stiffening = 0;
   double support_friction = -1;       ///< mu; negative = pinned supports
-  std::vector<int> region;            ///< particles of a region with its own msm_beta
-  double region_beta = -1;            ///< msm_beta inside `region` (negative: same as elsewhere)
+  /// Per-particle msm_beta, particle_count values (empty: msm_beta everywhere). A cluster takes
+  /// the mean over its members, so a stiffness map needs no cluster bookkeeping by the caller.
+  std::vector<double> particle_beta;
 };
 
 /// One recording prepared for repeated simulation (model, observations, support normal).
