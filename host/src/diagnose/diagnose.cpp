@@ -142,6 +142,46 @@ double golden(F&& f, double lo, double hi, double tolerance, double& best_x, dou
   return best_x;
 }
 
+// Per-patch stiffness split in two groups by msm_beta: the split that maximises the
+// between-group variance (particle-weighted, Otsu's criterion). The larger group is the bulk.
+struct PatchSplit {
+  std::vector<std::size_t> region;  // patch indices of the smaller group
+  double bulk_beta = 0;
+  double region_beta = 0;
+};
+
+PatchSplit split_patches(const std::vector<std::vector<int>>& patches, const std::vector<double>& beta) {
+  std::vector<std::size_t> order;
+  for (std::size_t k = 0; k < patches.size() && k < beta.size(); ++k) order.push_back(k);
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return beta[a] < beta[b]; });
+  double total_weight = 0;
+  double total_sum = 0;
+  for (std::size_t k : order) {
+    total_weight += static_cast<double>(patches[k].size());
+    total_sum += static_cast<double>(patches[k].size()) * beta[k];
+  }
+  PatchSplit best;
+  best.bulk_beta = total_weight > 0 ? total_sum / total_weight : 0.0;
+  double best_score = -1;
+  double weight = 0;
+  double sum = 0;
+  for (std::size_t cut = 0; cut + 1 < order.size(); ++cut) {
+    weight += static_cast<double>(patches[order[cut]].size());
+    sum += static_cast<double>(patches[order[cut]].size()) * beta[order[cut]];
+    const double low = sum / weight;
+    const double high = (total_sum - sum) / (total_weight - weight);
+    const double score = weight * (total_weight - weight) * (high - low) * (high - low);
+    if (score <= best_score) continue;
+    best_score = score;
+    const bool low_is_region = 2 * weight < total_weight;
+    best.region.assign(order.begin() + (low_is_region ? 0 : static_cast<long>(cut) + 1),
+                       low_is_region ? order.begin() + static_cast<long>(cut) + 1 : order.end());
+    best.region_beta = low_is_region ? low : high;
+    best.bulk_beta = low_is_region ? high : low;
+  }
+  return best;
+}
+
 class Fitter {
  public:
   Fitter(const RecordingSimulator& simulator, const Scorer& scorer, const EffectContext& context)
@@ -361,20 +401,8 @@ class Fitter {
     f.beta_std = std_of(0);
     for (int c = 1; c < p; ++c) f.std.push_back(std_of(c));
     if (first == 1) {
-      // Per-patch stiffness: report the bulk msm_beta (the particle-weighted median patch).
-      std::vector<std::pair<double, std::size_t>> by_beta;
-      for (std::size_t k = 0; k < context_.patches.size(); ++k) by_beta.push_back({f.values[k], context_.patches[k].size()});
-      std::sort(by_beta.begin(), by_beta.end());
-      std::size_t total = 0;
-      for (const auto& b : by_beta) total += b.second;
-      std::size_t seen = 0;
-      for (const auto& b : by_beta) {
-        seen += b.second;
-        if (2 * seen >= total) {
-          f.beta = b.first;
-          break;
-        }
-      }
+      // Per-patch stiffness: msm_beta is the bulk's (the larger group of patches by msm_beta).
+      f.beta = split_patches(context_.patches, f.values).bulk_beta;
       f.beta_std = std::numeric_limits<double>::infinity();
     }
     f.bic = n > 0 && f.score.fit_rss > 0 ? n * std::log(f.score.fit_rss / n) + fitted * std::log(n) : 0.0;
@@ -411,6 +439,16 @@ std::string number(double v) {
   out.precision(3);
   out << v;
   return out.str();
+}
+
+// The region of a per-patch stiffness fit as a sentence.
+std::string describe_region(const std::vector<std::vector<int>>& patches, const PatchSplit& split) {
+  std::vector<int> ids;
+  for (std::size_t k : split.region) ids.insert(ids.end(), patches[k].begin(), patches[k].end());
+  std::sort(ids.begin(), ids.end());
+  if (ids.empty()) return "";
+  return "Particles " + id_list(ids) + " are " + (split.region_beta < split.bulk_beta ? "stiffer" : "softer") +
+         " (msm_beta " + number(split.region_beta) + ") than the rest (msm_beta " + number(split.bulk_beta) + ").";
 }
 
 std::vector<double> magnitudes(const Recording& recording, const std::vector<double>& simulated) {
@@ -521,7 +559,8 @@ DiagnoseResult diagnose_recording(const Recording& recording, const DiagnoseOpti
   const ResidualField field = make_residual_field(recording.positions, baseline.simulated, n, dim);
   out.location = locate_mismatch(field, recording.frame_times_s, noise_std);
   context.located = out.location.particles;
-  context.patches = spatial_patches(simulator.rest(), dim, std::max(6, n / 8));
+  context.patches = spatial_patches(simulator.rest(), dim, std::max(6, (n - static_cast<int>(recording.fixed.size())) / 8),
+                                    recording.fixed);
   const std::map<std::string, double> signatures =
       residual_signatures(recording, baseline.simulated, field, out.location, noise_std);
 
@@ -602,6 +641,7 @@ DiagnoseResult diagnose_recording(const Recording& recording, const DiagnoseOpti
          << " by " << number(out.baseline.rms) << " " << recording.length_unit << " rms (noise " << number(noise_rms)
          << "); " << effect.physics << " explains it, cutting the held-out rms by " << number(100.0 * out.improvement)
          << " % and moving msm_beta from " << number(baseline.beta) << " to " << number(f.beta) << ".";
+    if (effect.replaces_beta) text << " " << describe_region(context.patches, split_patches(context.patches, f.values));
     if (ranked.size() > 1 && ranked[1].passes && fits[ranked[1].index].bic - f.bic < 6.0) {
       text << " " << effects[ranked[1].index].name << " fits almost as well; " << effect.experiment << ".";
     }

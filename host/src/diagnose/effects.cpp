@@ -68,8 +68,22 @@ double EffectParameter::coordinate(double physical) const {
   return std::isfinite(u) ? std::clamp(u, 0.0, 1.0) : 0.0;
 }
 
-std::vector<std::vector<int>> spatial_patches(const std::vector<double>& rest, int dimension, int target_size) {
-  const int n = dimension > 0 ? static_cast<int>(rest.size()) / dimension : 0;
+std::vector<std::vector<int>> spatial_patches(const std::vector<double>& all_rest, int dimension, int target_size,
+                                              const std::vector<int>& attached) {
+  const int total = dimension > 0 ? static_cast<int>(all_rest.size()) / dimension : 0;
+  // Patches are made of the free particles; attached ones join their nearest free particle's.
+  std::vector<unsigned char> is_attached(static_cast<std::size_t>(std::max(total, 0)), 0);
+  for (int id : attached) {
+    if (id >= 0 && id < total) is_attached[static_cast<std::size_t>(id)] = 1;
+  }
+  std::vector<int> free_ids;
+  std::vector<double> rest;
+  for (int i = 0; i < total; ++i) {
+    if (is_attached[static_cast<std::size_t>(i)] != 0) continue;
+    free_ids.push_back(i);
+    rest.insert(rest.end(), all_rest.begin() + i * dimension, all_rest.begin() + (i + 1) * dimension);
+  }
+  const int n = static_cast<int>(free_ids.size());
   if (n < 4) return {};
   const int k = std::clamp(n / std::max(target_size, 2), 2, n / 2);
   // Farthest-point seeds from the first particle, then Lloyd iterations: deterministic.
@@ -117,7 +131,17 @@ std::vector<std::vector<int>> spatial_patches(const std::vector<double>& rest, i
     }
   }
   std::vector<std::vector<int>> patches(static_cast<std::size_t>(k));
-  for (int i = 0; i < n; ++i) patches[static_cast<std::size_t>(label[static_cast<std::size_t>(i)])].push_back(i);
+  for (int i = 0; i < n; ++i) patches[static_cast<std::size_t>(label[static_cast<std::size_t>(i)])].push_back(free_ids[static_cast<std::size_t>(i)]);
+  for (int a = 0; a < total; ++a) {
+    if (is_attached[static_cast<std::size_t>(a)] == 0) continue;
+    const std::vector<double> at(all_rest.begin() + a * dimension, all_rest.begin() + (a + 1) * dimension);
+    int nearest_free = 0;
+    for (int i = 1; i < n; ++i) {
+      if (squared_distance(rest, dimension, i, at) < squared_distance(rest, dimension, nearest_free, at)) nearest_free = i;
+    }
+    patches[static_cast<std::size_t>(label[static_cast<std::size_t>(nearest_free)])].push_back(a);
+  }
+  for (std::vector<int>& patch : patches) std::sort(patch.begin(), patch.end());
   patches.erase(std::remove_if(patches.begin(), patches.end(), [](const std::vector<int>& p) { return p.empty(); }),
                 patches.end());
   return patches;

@@ -9,10 +9,12 @@
 //    gravity only if declared, msm_alpha 1. Noise: measured from the recording alone.
 // 3. Locate: residual field of the baseline, the particles and window where it concentrates,
 //    and the signature statistics.
-// 4. Every catalogued effect (effects.hpp) is refitted with msm_beta through the simulator by
-//    bounded coordinate search; uncertainty from a finite-difference Jacobian.
+// 4. Every catalogued effect (effects.hpp) is refitted with msm_beta through the simulator: a
+//    grid over the parameters whose response is flat near the null, msm_beta profiled out at
+//    each grid point, then bounded Levenberg-Marquardt; uncertainty from a finite-difference
+//    Jacobian.
 // 5. Select: an effect is named only when its held-out rms improves clearly on the baseline,
-//    its BIC gain is >= 10, its parameter is >= 3 standard deviations from the null and the
+//    its BIC gain is >= 10, a parameter is >= 3 standard deviations from its null and the
 //    baseline misfit stands clearly above the noise floor; otherwise `consistent`.
 // Host code: allocates, throws std::runtime_error with one line when a recording cannot be
 // diagnosed (too few frames, nothing moves, nothing observed).

@@ -70,10 +70,13 @@ struct Effect {
   bool replaces_beta = false;
 };
 
-/// Patches of about `target_size` particles by k-means on the rest positions
+/// Patches of about `target_size` free particles by k-means on the rest positions
 /// (particle-major, `dimension` values each), deterministic; at least 2 patches when there
-/// are at least 4 particles.
-std::vector<std::vector<int>> spatial_patches(const std::vector<double>& rest, int dimension, int target_size);
+/// are at least 4 free particles, none otherwise. The `attached` particles (fixed supports,
+/// whose own stiffness the motion barely shows) join the patch of their nearest free particle.
+/// Every particle is in exactly one patch; ids ascending within a patch.
+std::vector<std::vector<int>> spatial_patches(const std::vector<double>& rest, int dimension, int target_size,
+                                              const std::vector<int>& attached);
 
 /// The effects that can apply to this recording (friction needs a support, heterogeneity at
 /// least two patches). Latency is not offered: the MSM baseline
