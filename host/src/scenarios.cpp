@@ -86,14 +86,14 @@ ScenarioPlan foam_press(bool release) {
   return plan;
 }
 
-ScenarioPlan block_press(bool release) {
+ScenarioPlan block_press(bool release, const ScenarioOptions::BlockGrid& grid) {
   ScenarioPlan plan;
   plan.dimension = 3;
   plan.length_unit = "m";
   plan.spacing = 0.01;
-  const int nx = 5;
-  const int ny = 5;
-  const int nz = 4;
+  const int nx = grid.nx;
+  const int ny = grid.ny;
+  const int nz = grid.nz;
   for (int z = 0; z < nz; ++z) {
     for (int y = 0; y < ny; ++y) {
       for (int x = 0; x < nx; ++x) {
@@ -104,7 +104,7 @@ ScenarioPlan block_press(bool release) {
       }
     }
   }
-  plan.tool = ((nz - 1) * ny + 2) * nx + 2;
+  plan.tool = ((nz - 1) * ny + ny / 2) * nx + nx / 2;
   plan.duration_s = kLeadIn_s + 3.0;
   if (release) {
     plan.release_s = plan.duration_s;
@@ -112,12 +112,13 @@ ScenarioPlan block_press(bool release) {
   }
   plan.rate_hz = 30.0;
   plan.tool_direction = {0.0, 0.0, -1.0};
-  plan.height = 0.03;
-  plan.travel = 0.006;
+  // For the default 5 x 5 x 4 grid these are exactly 0.03, 0.006 and {0.01, 0.02, 0.015}.
+  plan.height = 0.01 * (nz - 1);
+  plan.travel = 0.2 * plan.height;
   plan.object = "simulated 3D block pressed from above";
   plan.down = {0.0, 0.0, -1.0};
   plan.support_normal = {0.0, 0.0, 1.0};
-  plan.inclusion_centre = {0.01, 0.02, 0.015};
+  plan.inclusion_centre = {0.01 * (nx - 1) / 4, 0.01 * (ny - 1) / 2, 0.01 * (nz - 1) / 2};
   plan.gravity_g = kGravityBlock;
   return plan;
 }
@@ -223,9 +224,10 @@ ScenarioPlan dome_press() {
   return plan;
 }
 
-ScenarioPlan plan_for(const std::string& name, bool release) {
+ScenarioPlan plan_for(const std::string& name, const ScenarioOptions& options) {
+  const bool release = options.release;
   if (name == "foam_press") return foam_press(release);
-  if (name == "block_press") return block_press(release);
+  if (name == "block_press") return block_press(release, options.block_grid);
   if (name == "cantilever_strip") return cantilever_strip();
   if (name == "ring_squeeze") return ring_squeeze();
   if (name == "dome_press") return dome_press();
@@ -327,6 +329,9 @@ void check_options(const ScenarioOptions& options) {
   }
   if (!(options.occlusion >= 0.0 && options.occlusion <= 0.5)) throw std::invalid_argument("--occlusion must be in [0, 0.5]");
   if (!(options.depth >= 0.0 && options.depth <= 2.0)) throw std::invalid_argument("--depth must be in (0, 2]");
+  for (const int count : {options.block_grid.nx, options.block_grid.ny, options.block_grid.nz}) {
+    if (count < 2 || count > 64) throw std::invalid_argument("block_grid must be 2..64 particles along each axis");
+  }
 }
 
 }  // namespace
@@ -337,7 +342,11 @@ std::vector<std::string> scenario_names() {
 
 ScenarioResult make_scenario(const std::string& name, const ScenarioOptions& options) {
   check_options(options);
-  ScenarioPlan plan = plan_for(name, options.release);
+  const ScenarioOptions::BlockGrid grid = options.block_grid;
+  const ScenarioOptions::BlockGrid default_grid;
+  const bool default_size = grid.nx == default_grid.nx && grid.ny == default_grid.ny && grid.nz == default_grid.nz;
+  if (name != "block_press" && !default_size) throw std::invalid_argument("block_grid applies to block_press only");
+  ScenarioPlan plan = plan_for(name, options);
   const double own_rate_hz = plan.rate_hz;
   if (options.rate_hz > 0.0) plan.rate_hz = options.rate_hz;
 

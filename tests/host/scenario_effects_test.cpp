@@ -312,5 +312,53 @@ TEST(scenario_effects, OptionsOutOfRangeAreRefused) {
   }
 }
 
+TEST(scenario_effects, BlockGridSizesTheBlockAndKeepsTheToolOnTheTopCentre) {
+  ScenarioOptions options;
+  options.noise = 0.0;
+  const ScenarioResult standard = make_scenario("block_press", options);
+  options.block_grid = {5, 5, 4};
+  EXPECT_TRUE(bitwise_equal(standard.recording, make_scenario("block_press", options).recording));
+  EXPECT_EQ(standard.recording.particle_count, 100);
+  EXPECT_EQ(standard.recording.driven[0].id, 87);
+
+  options.block_grid = {10, 10, 5};
+  const ScenarioResult large = make_scenario("block_press", options);
+  const Recording& r = large.recording;
+  ASSERT_EQ(r.particle_count, 500);
+  EXPECT_EQ(r.fixed.size(), 100u);  // the bottom layer
+  EXPECT_EQ(r.fixed.back(), 99);
+  ASSERT_EQ(r.driven.size(), 1u);
+  const int tool = r.driven[0].id;
+  EXPECT_EQ(tool, 455);
+  EXPECT_NEAR(r.position(0, tool, 0), 0.05, 1e-12);
+  EXPECT_NEAR(r.position(0, tool, 1), 0.05, 1e-12);
+  EXPECT_NEAR(r.position(0, tool, 2), 0.04, 1e-12);
+  // Depth 0.2 of the 40 mm height: 8 mm down once the 1 s press (from 0.5 s) is done.
+  EXPECT_NEAR(r.position(45, tool, 2) - r.position(0, tool, 2), -0.008, 1e-12);
+  EXPECT_DOUBLE_EQ(large.truth["tool_travel"].get<double>(), 0.2 * 0.04);
+  // The inclusion is inside the larger block too.
+  ScenarioOptions hetero = options;
+  parse_effect_argument("heterogeneity", hetero);
+  const ScenarioResult region = make_scenario("block_press", hetero);
+  EXPECT_GT(region.truth["effect_details"]["region_clusters"].get<int>(), 0);
+}
+
+TEST(scenario_effects, BadBlockGridsAreRefused) {
+  for (const ScenarioOptions::BlockGrid grid :
+       {ScenarioOptions::BlockGrid{1, 5, 4}, ScenarioOptions::BlockGrid{5, 0, 4},
+        ScenarioOptions::BlockGrid{5, 5, 1}, ScenarioOptions::BlockGrid{65, 5, 4},
+        ScenarioOptions::BlockGrid{5, 5, -3}}) {
+    ScenarioOptions options;
+    options.block_grid = grid;
+    EXPECT_THROW((void)make_scenario("block_press", options), std::invalid_argument)
+        << grid.nx << " x " << grid.ny << " x " << grid.nz;
+  }
+  // A grid other than the default means nothing to the other scenarios: refused, not ignored.
+  ScenarioOptions options;
+  options.block_grid = {10, 10, 5};
+  EXPECT_THROW((void)make_scenario("foam_press", options), std::invalid_argument);
+  EXPECT_THROW((void)make_scenario("dome_press", options), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace pliant::host

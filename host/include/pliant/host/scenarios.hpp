@@ -23,7 +23,10 @@
 //   the recording goes on for 1.5 s more.
 // - block_press: a 3D block (m) of 5 x 5 x 4 particles at 10 mm spacing, bottom layer fixed,
 //   the top-centre particle pressed 6 mm (depth 0.2) down over 1 s and held for 2 s.
-//   30 frames/s. Release as for foam_press.
+//   30 frames/s. Release as for foam_press. ScenarioOptions::block_grid changes the particle
+//   counts (e.g. 10 x 10 x 5 = 500 particles for timing); the tool stays on the top-centre
+//   particle (x = nx / 2, y = ny / 2), depth stays a fraction of the height (nz - 1) x 10 mm and
+//   the heterogeneity inclusion stays at a quarter of the width, mid-depth, mid-height.
 // - cantilever_strip: a 2D strip (m) of 12 x 3 particles at 10 mm spacing clamped by its two
 //   left columns; the tip particle is pulled 20 mm (depth 1.0 of the 20 mm height) down over
 //   1 s, held 1 s and released, then the strip swings freely for 2 s. 60 frames/s.
@@ -79,6 +82,11 @@ struct ScenarioOptions {
   double occlusion = 0.0;              ///< share of (particle, frame) observations removed, [0, 0.5]
   double depth = 0.0;                  ///< tool amplitude / object height; 0 = the scenario's own
   bool release = false;                ///< foam_press, block_press: the tool lets go for the last 1.5 s
+  /// block_press only: particles along x, y and z (z up, layer 0 fixed); each 2..64. Another
+  /// scenario refuses a grid other than the default.
+  struct BlockGrid {
+    int nx = 5, ny = 5, nz = 4;
+  } block_grid;
 };
 
 struct ScenarioResult {
@@ -104,7 +112,8 @@ void parse_effect_argument(const std::string& text, ScenarioOptions& options);
 /// Runs a scenario. Throws std::invalid_argument (one line naming the option) for an unknown
 /// name or options out of range (beta outside [0, 1], alpha outside (0, 1], negative noise,
 /// rate <= 0 when given, unknown effect or effect parameter, substeps outside 1..64, cluster
-/// radius outside [1, 4], occlusion outside [0, 0.5], depth outside [0, 2]).
+/// radius outside [1, 4], occlusion outside [0, 0.5], depth outside [0, 2], block_grid outside
+/// 2..64 per axis or not the default outside block_press).
 ScenarioResult make_scenario(const std::string& name, const ScenarioOptions& options);
 
 /// Writes the recording directory and truth.json beside its recording.json.
