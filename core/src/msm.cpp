@@ -10,6 +10,9 @@
 namespace pliant {
 namespace {
 
+// Newton iterations on the 3D rotation (polar.hpp) allowed per cluster and step.
+constexpr int kRotationIterations = 24;
+
 template <typename Scalar>
 bool finite(Scalar value) noexcept {
   return std::isfinite(value);
@@ -30,8 +33,284 @@ Eigen::Matrix<Scalar, 2, 2> rotation_of(const Eigen::Matrix<Scalar, 2, 2>& apq,
 template <typename Scalar>
 Eigen::Matrix<Scalar, 3, 3> rotation_of(const Eigen::Matrix<Scalar, 3, 3>& apq,
                                         Eigen::Quaternion<Scalar>& warm) noexcept {
-  (void)extract_rotation(apq, warm, 24, simulation_rotation_tolerance<Scalar>());
-  return warm.toRotationMatrix();
+  Eigen::Matrix<Scalar, 3, 3> rotation;
+  (void)extract_rotation(apq, warm, rotation, kRotationIterations, simulation_rotation_tolerance<Scalar>());
+  return rotation;
+}
+
+// out = sum of the items at byte offsets offset[k] from `items`, k in [begin, end) (the model's
+// precomputed membership offsets). Two interleaved accumulators: these gathers are the bulk of
+// a step and a single running sum is latency-bound.
+template <typename Item>
+inline void gather_sum(const Item* items, const std::int32_t* offset, int begin, int end, Item& out) noexcept {
+  const char* base = reinterpret_cast<const char*>(items);
+  Item even = Item::Zero();
+  Item odd = Item::Zero();
+  int k = begin;
+  for (; k + 1 < end; k += 2) {
+    even += *reinterpret_cast<const Item*>(base + offset[k]);
+    odd += *reinterpret_cast<const Item*>(base + offset[k + 1]);
+  }
+  if (k < end) even += *reinterpret_cast<const Item*>(base + offset[k]);
+  out = even + odd;
+}
+
+// Goal map [G | b] (column-major out[Dim * (Dim + 1)]) of an elastic cluster:
+// G = (1 - beta) R + beta A_pq A_qq^-1 and b = t - G r_c, with t = (sum m x) / M. Column-major
+// inputs: apq and aqq_inverse [Dim * Dim], rotation [Dim * Dim], mx_sum and rest_centroid [Dim].
+template <int Dim, typename Scalar>
+PLIANT_INLINE void elastic_goal_map(const Scalar* apq, const Scalar* aqq_inverse, const Scalar* rotation, Scalar beta,
+                                    const Scalar* mx_sum, Scalar inverse_mass, const Scalar* rest_centroid,
+                                    Scalar* out) noexcept {
+  const Scalar keep = Scalar(1) - beta;
+  for (int col = 0; col < Dim; ++col) {
+    for (int row = 0; row < Dim; ++row) {
+      Scalar affine = apq[row] * aqq_inverse[col * Dim];
+      for (int k = 1; k < Dim; ++k) affine += apq[k * Dim + row] * aqq_inverse[col * Dim + k];
+      out[col * Dim + row] = keep * rotation[col * Dim + row] + beta * affine;
+    }
+  }
+  for (int row = 0; row < Dim; ++row) {
+    Scalar mapped = out[row] * rest_centroid[0];
+    for (int k = 1; k < Dim; ++k) mapped += out[k * Dim + row] * rest_centroid[k];
+    out[Dim * Dim + row] = mx_sum[row] * inverse_mass - mapped;
+  }
+}
+
+// A_pq relative to the cluster's rest centroid from the moment sum [sum m x r^T | sum m x]
+// (column-major sum[Dim * (Dim + 1)]): A_pq = sum m x r^T - (sum m x) r_c^T.
+template <int Dim, typename Scalar>
+PLIANT_INLINE void cluster_apq(const Scalar* sum, const Scalar* rest_centroid, Scalar* apq) noexcept {
+  for (int col = 0; col < Dim; ++col) {
+    for (int row = 0; row < Dim; ++row) apq[col * Dim + row] = sum[col * Dim + row] - sum[Dim * Dim + row] * rest_centroid[col];
+  }
+}
+
+// The elastic model's cluster pass (no plasticity, relaxation or stiffening): per cluster the
+// goal map [G | b] and the updated rotation. Clusters are taken kMsmClusterBatch at a time and
+// laid out lane-wise (structure of arrays) so that the arithmetic, identical for every cluster,
+// runs as branch-free loops over lanes that the compiler vectorises. In 3D the first Newton
+// iteration of extract_rotation runs lane-wise too; a lane whose first iteration is a plain
+// Newton step (no special case) but not yet below the tolerance is continued by the scalar
+// extract_rotation from there, and a lane that meets a special case (zero or non-finite A_pq,
+// a warm start off the unit sphere, an ascent or clamped step) is redone by it from its warm
+// start. Each lane therefore does the same arithmetic as the scalar code: results do not depend
+// on the batching.
+template <int Dim, typename Scalar>
+void elastic_cluster_pass(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>& params,
+                          MsmState<Dim, Scalar>& state) noexcept {
+  using Moment = Eigen::Matrix<Scalar, Dim, Dim + 1>;
+  using Mat = Eigen::Matrix<Scalar, Dim, Dim>;
+  constexpr int kBatch = kMsmClusterBatch;
+  constexpr int kMoment = Dim * (Dim + 1);
+  constexpr int kMat = Dim * Dim;
+  constexpr int kWarm = 4;  // 3D quaternion (w, x, y, z); 2D rotation matrix, column-major
+  constexpr int kFields = kMsmClusterLaneFields<Dim>;
+  // Array extents (unsigned, as -Wsign-conversion wants them).
+  constexpr auto kBatchN = static_cast<std::size_t>(kBatch);
+  constexpr auto kMomentN = static_cast<std::size_t>(kMoment);
+  constexpr auto kMatN = static_cast<std::size_t>(kMat);
+  constexpr auto kWarmN = static_cast<std::size_t>(kWarm);
+  constexpr auto kDimN = static_cast<std::size_t>(Dim);
+  constexpr Scalar kEpsilon = std::numeric_limits<Scalar>::epsilon();
+  const Scalar tolerance = simulation_rotation_tolerance<Scalar>();
+  const Scalar stop2 = tolerance * tolerance;
+  const int clusters = model.cluster_count;
+  alignas(64) Scalar beta[kBatchN];
+  for (int lane = 0; lane < kBatch; ++lane) beta[lane] = params.msm_beta;
+  for (int first = 0; first < clusters; first += kBatch) {
+    const int count = std::min(kBatch, clusters - first);
+    // Model constants of this batch: [field][lane].
+    const Scalar* constants = model.cluster_lanes + static_cast<std::ptrdiff_t>(first) * kFields;
+    const Scalar* centre = constants;
+    const Scalar* aqq = constants + Dim * kBatch;
+    const Scalar* inverse_mass = constants + (Dim + kMat) * kBatch;
+    alignas(64) Scalar sum[kMomentN][kBatchN];
+    alignas(64) Scalar apq[kMatN][kBatchN];
+    alignas(64) Scalar guard[kBatchN];
+    alignas(64) Scalar warm[kWarmN][kBatchN];      // warm start, then the result
+    alignas(64) Scalar rotation[kMatN][kBatchN];   // its matrix, then the result's
+    alignas(64) Scalar turned[kWarmN][kBatchN];    // 3D: after the first Newton iteration
+    alignas(64) Scalar turned_rotation[kMatN][kBatchN];
+    alignas(64) Scalar plain_step[kBatchN];
+    alignas(64) Scalar converged[kBatchN];
+    alignas(64) Scalar status[kBatchN];  // 0 special case, 1 first step plain, 2 also converged
+    alignas(64) Scalar goal[kMomentN][kBatchN];
+    for (int lane = 0; lane < kBatch; ++lane) {
+      if (lane >= count) {  // padding: a copy of lane 0, computed and discarded
+        for (int e = 0; e < kMoment; ++e) sum[e][lane] = sum[e][0];
+        for (int e = 0; e < kWarm; ++e) warm[e][lane] = warm[e][0];
+        if (params.cluster_beta != nullptr) beta[lane] = beta[0];
+        continue;
+      }
+      const int c = first + lane;
+      Moment moment;
+      gather_sum(state.moment, model.member_byte_offset, model.cluster_begin[c], model.cluster_begin[c + 1], moment);
+      for (int e = 0; e < kMoment; ++e) sum[e][lane] = moment.data()[e];
+      if constexpr (Dim == 3) {
+        const Eigen::Quaternion<Scalar>& q = state.rotation[c];
+        warm[0][lane] = q.w();
+        warm[1][lane] = q.x();
+        warm[2][lane] = q.y();
+        warm[3][lane] = q.z();
+      } else {
+        for (int e = 0; e < kWarm; ++e) warm[e][lane] = state.rotation[c].data()[e];
+      }
+      if (params.cluster_beta != nullptr) beta[lane] = params.cluster_beta[c];
+    }
+    // A_pq and the rotation's starting point, lane-wise.
+    for (int lane = 0; lane < kBatch; ++lane) {
+      Scalar s[kMomentN];
+      for (int e = 0; e < kMoment; ++e) s[e] = sum[e][lane];
+      Scalar rc[kDimN];
+      for (int e = 0; e < Dim; ++e) rc[e] = centre[e * kBatch + lane];
+      Scalar a[kMatN];
+      cluster_apq<Dim>(s, rc, a);
+      for (int e = 0; e < kMat; ++e) apq[e][lane] = a[e];
+      Scalar r[kMatN];
+      bool ok;
+      if constexpr (Dim == 3) {
+        const Scalar w = warm[0][lane];
+        const Scalar x = warm[1][lane];
+        const Scalar y = warm[2][lane];
+        const Scalar z = warm[3][lane];
+        const Scalar scale2 = detail::squared_sum9(a);
+        const Scalar length2 = w * w + x * x + y * y + z * z;
+        // extract_rotation's preliminaries: nothing to do for a finite, nonzero A_pq and a
+        // unit warm start.
+        ok = (scale2 > Scalar(0)) & (scale2 <= std::numeric_limits<Scalar>::max()) &
+             (std::abs(length2 - Scalar(1)) <= Scalar(64) * kEpsilon);
+        guard[lane] = std::sqrt(kEpsilon * scale2);
+        detail::quaternion_to_matrix(w, x, y, z, r);
+      } else {
+        // extract_rotation (2D), with a margin on its acceptance test so that a lane taken here
+        // is certainly taken there.
+        const Scalar cos_part = a[0] + a[3];
+        const Scalar sin_part = a[1] - a[2];
+        const Scalar length2 = cos_part * cos_part + sin_part * sin_part;
+        const Scalar scale2 = a[0] * a[0] + a[1] * a[1] + a[2] * a[2] + a[3] * a[3];
+        ok = (length2 > Scalar(4) * kEpsilon * kEpsilon * scale2) &
+             (length2 <= Scalar(0.5) * std::numeric_limits<Scalar>::max());
+        const Scalar inverse_length = Scalar(1) / std::sqrt(length2);
+        const Scalar co = cos_part * inverse_length;
+        const Scalar si = sin_part * inverse_length;
+        r[0] = co;
+        r[1] = si;
+        r[2] = -si;
+        r[3] = co;
+        for (int e = 0; e < kWarm; ++e) warm[e][lane] = r[e];
+      }
+      for (int e = 0; e < kMat; ++e) rotation[e][lane] = r[e];
+      status[lane] = ok ? Scalar(2) : Scalar(0);
+    }
+    if constexpr (Dim == 3) {
+      // The first Newton iteration, lane-wise (extract_rotation's loop body).
+      for (int lane = 0; lane < kBatch; ++lane) {
+        Scalar a[kMatN];
+        Scalar r[kMatN];
+        for (int e = 0; e < kMat; ++e) {
+          a[e] = apq[e][lane];
+          r[e] = rotation[e][lane];
+        }
+        const detail::RotationTerms<Scalar> t = detail::rotation_terms(r, a);
+        const Scalar g = guard[lane];
+        const Scalar g2 = g * g;
+        const Scalar g3 = g2 * g;
+        const Scalar angle2 = t.n0 * t.n0 + t.n1 * t.n1 + t.n2 * t.n2;
+        // A plain Newton step: positive definite H, a nonzero step of at most 1 rad.
+        const bool plain = (t.h00 > g) & (t.c22 > g2) & (t.det > g3) & (angle2 > Scalar(0)) & (angle2 <= Scalar(1)) &
+                           (status[lane] != Scalar(0));
+        plain_step[lane] = plain ? Scalar(1) : Scalar(0);
+        converged[lane] = angle2 < stop2 ? Scalar(1) : Scalar(0);
+        Scalar w = warm[0][lane];
+        Scalar x = warm[1][lane];
+        Scalar y = warm[2][lane];
+        Scalar z = warm[3][lane];
+        const Scalar half = Scalar(0.5);
+        detail::quaternion_advance(w, x, y, z, half * t.n0, half * t.n1, half * t.n2);
+        detail::quaternion_to_matrix(w, x, y, z, r);
+        turned[0][lane] = w;
+        turned[1][lane] = x;
+        turned[2][lane] = y;
+        turned[3][lane] = z;
+        for (int e = 0; e < kMat; ++e) turned_rotation[e][lane] = r[e];
+      }
+      // status (exact on these small integers): 2 plain and converged, 1 plain, else 0.
+      for (int lane = 0; lane < kBatch; ++lane) status[lane] = plain_step[lane] * (Scalar(1) + converged[lane]);
+    }
+    // Lanes done lane-wise take the result of the first iteration; the scalar code finishes
+    // the others from where they are.
+    for (int lane = 0; lane < count; ++lane) {
+      const Scalar lane_status = status[lane];
+      if constexpr (Dim == 3) {
+        if (lane_status == Scalar(2)) {
+          for (int e = 0; e < kWarm; ++e) warm[e][lane] = turned[e][lane];
+          for (int e = 0; e < kMat; ++e) rotation[e][lane] = turned_rotation[e][lane];
+          continue;
+        }
+      } else {
+        if (lane_status != Scalar(0)) continue;
+      }
+      const int c = first + lane;
+      Mat a;
+      for (int e = 0; e < kMat; ++e) a.data()[e] = apq[e][lane];
+      Mat r;
+      if constexpr (Dim == 3) {
+        const bool resume = lane_status == Scalar(1);
+        Eigen::Quaternion<Scalar> q;
+        q.w() = resume ? turned[0][lane] : warm[0][lane];
+        q.x() = resume ? turned[1][lane] : warm[1][lane];
+        q.y() = resume ? turned[2][lane] : warm[2][lane];
+        q.z() = resume ? turned[3][lane] : warm[3][lane];
+        (void)extract_rotation(a, q, r, resume ? kRotationIterations - 1 : kRotationIterations,
+                               simulation_rotation_tolerance<Scalar>());
+        warm[0][lane] = q.w();
+        warm[1][lane] = q.x();
+        warm[2][lane] = q.y();
+        warm[3][lane] = q.z();
+      } else {
+        Mat previous = state.rotation[c];
+        (void)extract_rotation(a, previous);
+        r = previous;
+        for (int e = 0; e < kWarm; ++e) warm[e][lane] = r.data()[e];
+      }
+      for (int e = 0; e < kMat; ++e) rotation[e][lane] = r.data()[e];
+    }
+    // Goal maps, lane-wise.
+    for (int lane = 0; lane < kBatch; ++lane) {
+      Scalar a[kMatN];
+      Scalar r[kMatN];
+      Scalar q[kMatN];
+      for (int e = 0; e < kMat; ++e) {
+        a[e] = apq[e][lane];
+        r[e] = rotation[e][lane];
+        q[e] = aqq[e * kBatch + lane];
+      }
+      Scalar mx[kDimN];
+      Scalar rc[kDimN];
+      for (int e = 0; e < Dim; ++e) {
+        mx[e] = sum[kMat + e][lane];
+        rc[e] = centre[e * kBatch + lane];
+      }
+      Scalar out[kMomentN];
+      elastic_goal_map<Dim>(a, q, r, beta[lane], mx, inverse_mass[lane], rc, out);
+      for (int e = 0; e < kMoment; ++e) goal[e][lane] = out[e];
+    }
+    for (int lane = 0; lane < count; ++lane) {
+      const int c = first + lane;
+      Scalar* map = state.cluster_goal_map[c].data();
+      for (int e = 0; e < kMoment; ++e) map[e] = goal[e][lane];
+      if constexpr (Dim == 3) {
+        Eigen::Quaternion<Scalar>& q = state.rotation[c];
+        q.w() = warm[0][lane];
+        q.x() = warm[1][lane];
+        q.y() = warm[2][lane];
+        q.z() = warm[3][lane];
+      } else {
+        for (int e = 0; e < kWarm; ++e) state.rotation[c].data()[e] = warm[e][lane];
+      }
+    }
+  }
 }
 
 // Mueller 2005 plasticity: the plastic state creeps toward the cluster's strain while the
@@ -215,10 +494,18 @@ Status msm_step(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>
   for (int i = 0; i < n; ++i) origin += state.predicted[i];
   origin /= static_cast<Scalar>(n);
   for (int i = 0; i < n; ++i) {
-    const Vec mx = model.mass[i] * (state.predicted[i] - origin);
-    Moment& moment = state.moment[i];
-    moment.template leftCols<Dim>().noalias() = mx * (model.rest[i] - model.rest_origin).transpose();
-    moment.col(Dim) = mx;
+    const Scalar mass = model.mass[i];
+    Scalar mx[static_cast<std::size_t>(Dim)];
+    Scalar r[static_cast<std::size_t>(Dim)];
+    for (int d = 0; d < Dim; ++d) {
+      mx[d] = mass * (state.predicted[i](d) - origin(d));
+      r[d] = model.rest[i](d) - model.rest_origin(d);
+    }
+    Scalar* moment = state.moment[i].data();
+    for (int col = 0; col < Dim; ++col) {
+      for (int row = 0; row < Dim; ++row) moment[col * Dim + row] = mx[row] * r[col];
+    }
+    for (int row = 0; row < Dim; ++row) moment[Dim * Dim + row] = mx[row];
   }
   const bool plastic_on = params.plastic_creep > Scalar(0);
   const bool relax_on = params.relaxation_fraction > Scalar(0);
@@ -226,9 +513,11 @@ Status msm_step(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>
   const bool rest_changes = plastic_on || relax_on;
   // Exact decay of V toward the strain over one step, stable for any dt / tau.
   const Scalar relax_rate = relax_on ? Scalar(1) - std::exp(-dt / params.relaxation_time_s) : Scalar(0);
-  for (int c = 0; c < model.cluster_count; ++c) {
-    Moment sum = Moment::Zero();
-    for (int k = model.cluster_begin[c]; k < model.cluster_begin[c + 1]; ++k) sum += state.moment[model.members[k]];
+  const bool elastic = !rest_changes && !stiffen_on;
+  if (elastic) elastic_cluster_pass(model, params, state);
+  for (int c = 0; !elastic && c < model.cluster_count; ++c) {
+    Moment sum;
+    gather_sum(state.moment, model.member_byte_offset, model.cluster_begin[c], model.cluster_begin[c + 1], sum);
     const Vec rest_centroid = model.cluster_rest_centroid[c] - model.rest_origin;
     const Mat apq_rest = sum.template leftCols<Dim>() - sum.col(Dim) * rest_centroid.transpose();
     const Vec centroid = sum.col(Dim) * model.cluster_inverse_mass[c];
@@ -276,13 +565,22 @@ Status msm_step(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>
     } else if (state.driven_now[i] != 0) {
       next = state.predicted[i];  // the goal of a driven particle is its target
     } else if (model.inverse_cluster_count[i] > Scalar(0)) {
-      Moment map_sum = Moment::Zero();
-      for (int k = model.particle_cluster_begin[i]; k < model.particle_cluster_begin[i + 1]; ++k) {
-        map_sum += state.cluster_goal_map[model.particle_clusters[k]];
+      Moment map_sum;
+      gather_sum(state.cluster_goal_map, model.particle_cluster_byte_offset, model.particle_cluster_begin[i],
+                 model.particle_cluster_begin[i + 1], map_sum);
+      // Mean goal: (sum of G) r + (sum of b), over the clusters holding i.
+      const Scalar* g = map_sum.data();
+      Scalar r[static_cast<std::size_t>(Dim)];
+      for (int d = 0; d < Dim; ++d) r[d] = model.rest[i](d) - model.rest_origin(d);
+      const Scalar inverse_count = model.inverse_cluster_count[i];
+      const Scalar alpha = params.msm_alpha;
+      for (int row = 0; row < Dim; ++row) {
+        Scalar goal = g[row] * r[0];
+        for (int k = 1; k < Dim; ++k) goal += g[k * Dim + row] * r[k];
+        goal = (goal + g[Dim * Dim + row]) * inverse_count;
+        const Scalar x = state.predicted[i](row);
+        next(row) = x + alpha * (origin(row) + goal - x);
       }
-      const Vec goal_offset = (map_sum.template leftCols<Dim>() * (model.rest[i] - model.rest_origin) + map_sum.col(Dim)) *
-                              model.inverse_cluster_count[i];
-      next = state.predicted[i] + params.msm_alpha * (origin + goal_offset - state.predicted[i]);
     } else {
       next = state.predicted[i];
     }

@@ -210,6 +210,10 @@ Status build(Arena& arena, const MsmModelConfig<Dim, Scalar>& config, MsmModel<D
   const int clusters = enumerate_clusters(config, radius_squared, [&](int, int) { ++memberships; });
   if (clusters < 1) return Status::degenerate_cluster;
 
+  // The step's gathers address per-particle and per-cluster blocks by int32 byte offsets.
+  constexpr auto kMomentBytes = static_cast<long long>(sizeof(Eigen::Matrix<Scalar, Dim, Dim + 1>));
+  if (static_cast<long long>(std::max(n, clusters)) * kMomentBytes > 0x7fffffffLL) return Status::invalid_argument;
+
   MsmModel<Dim, Scalar> m;
   m.particle_count = n;
   m.cluster_count = clusters;
@@ -228,6 +232,10 @@ Status build(Arena& arena, const MsmModelConfig<Dim, Scalar>& config, MsmModel<D
   m.cluster_aqq_inverse = arena.carve<Mat>(static_cast<std::size_t>(clusters));
   m.particle_cluster_begin = arena.carve<std::int32_t>(static_cast<std::size_t>(n) + 1);
   m.particle_clusters = arena.carve<std::int32_t>(static_cast<std::size_t>(memberships));
+  m.member_byte_offset = arena.carve<std::int32_t>(static_cast<std::size_t>(memberships));
+  m.particle_cluster_byte_offset = arena.carve<std::int32_t>(static_cast<std::size_t>(memberships));
+  const int batches = (clusters + kMsmClusterBatch - 1) / kMsmClusterBatch;
+  m.cluster_lanes = arena.carve<Scalar>(static_cast<std::size_t>(batches) * kMsmClusterLaneFields<Dim> * kMsmClusterBatch);
   if (arena.exhausted()) return Status::capacity_exceeded;
 
   for (int i = 0; i < n; ++i) {
@@ -264,6 +272,10 @@ Status build(Arena& arena, const MsmModelConfig<Dim, Scalar>& config, MsmModel<D
       m.inverse_cluster_count[j] -= Scalar(1);
       m.particle_clusters[m.particle_cluster_begin[j] + static_cast<std::int32_t>(m.inverse_cluster_count[j])] = c;
     }
+  }
+  for (int k = 0; k < memberships; ++k) {
+    m.member_byte_offset[k] = static_cast<std::int32_t>(m.members[k] * kMomentBytes);
+    m.particle_cluster_byte_offset[k] = static_cast<std::int32_t>(m.particle_clusters[k] * kMomentBytes);
   }
   VecD origin = VecD::Zero();
   for (int i = 0; i < n; ++i) {
@@ -314,6 +326,16 @@ Status build(Arena& arena, const MsmModelConfig<Dim, Scalar>& config, MsmModel<D
     m.cluster_aqq_inverse[c] = aqq_inverse.template cast<Scalar>();
     m.cluster_rest_centroid[c] = centroid.template cast<Scalar>();
     m.cluster_inverse_mass[c] = static_cast<Scalar>(1.0 / mass_sum);
+  }
+  for (int b = 0; b < batches; ++b) {
+    Scalar* block = m.cluster_lanes + static_cast<std::ptrdiff_t>(b) * kMsmClusterLaneFields<Dim> * kMsmClusterBatch;
+    for (int lane = 0; lane < kMsmClusterBatch; ++lane) {
+      const int c = b * kMsmClusterBatch + lane < clusters ? b * kMsmClusterBatch + lane : b * kMsmClusterBatch;
+      int field = 0;
+      for (int d = 0; d < Dim; ++d) block[field++ * kMsmClusterBatch + lane] = m.cluster_rest_centroid[c](d) - m.rest_origin(d);
+      for (int e = 0; e < Dim * Dim; ++e) block[field++ * kMsmClusterBatch + lane] = m.cluster_aqq_inverse[c].data()[e];
+      block[field * kMsmClusterBatch + lane] = m.cluster_inverse_mass[c];
+    }
   }
   model = m;
   return Status::ok;

@@ -59,6 +59,11 @@ struct MsmModelConfig {
   ClusterConfig clusters;
 };
 
+/// Clusters per batch of the step's vectorised cluster pass (see MsmModel::cluster_lanes).
+inline constexpr int kMsmClusterBatch = 8;
+template <int Dim>
+inline constexpr int kMsmClusterLaneFields = Dim + Dim * Dim + 1;
+
 template <int Dim, typename Scalar>
 struct MsmModel {
   using Vec = Eigen::Matrix<Scalar, Dim, 1>;
@@ -83,6 +88,17 @@ struct MsmModel {
   /// particle_clusters[particle_cluster_begin[i] .. particle_cluster_begin[i + 1]).
   std::int32_t* particle_cluster_begin = nullptr;  ///< [particle_count + 1]
   std::int32_t* particle_clusters = nullptr;       ///< [membership_count] cluster ids
+  /// The same two lists as byte offsets into the step's per-particle moments and per-cluster
+  /// goal maps (members[k] and particle_clusters[k] times sizeof(Eigen::Matrix<Scalar, Dim,
+  /// Dim + 1>)), which spares the step's gathers an index multiplication per membership.
+  std::int32_t* member_byte_offset = nullptr;          ///< [membership_count]
+  std::int32_t* particle_cluster_byte_offset = nullptr;  ///< [membership_count]
+  /// Per-cluster constants of the step in batches of kMsmClusterBatch clusters, lane-wise
+  /// (structure of arrays) for its vectorised cluster pass: per batch b, field f, lane l at
+  /// cluster_lanes[(b * kMsmClusterLaneFields<Dim> + f) * kMsmClusterBatch + l], fields the
+  /// rest centroid relative to rest_origin (Dim), cluster_aqq_inverse column-major (Dim^2)
+  /// and cluster_inverse_mass (1). Lanes past the last cluster repeat the batch's first.
+  Scalar* cluster_lanes = nullptr;
   /// Mean rest position. The step works in coordinates relative to it (rest) and to the
   /// current mean position (deformed), which keeps float sums of x q^T precise.
   Vec rest_origin = Vec::Zero();
