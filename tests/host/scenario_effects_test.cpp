@@ -12,6 +12,7 @@
 
 #include "pliant/host/recording.hpp"
 #include "pliant/host/scenarios.hpp"
+#include "../support/temp_dir.hpp"
 
 namespace pliant::host {
 namespace {
@@ -52,24 +53,6 @@ std::string read_text(const fs::path& path) {
   return text.str();
 }
 
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "pliant_effects_XXXXXX").string();
-    if (mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
-    path_ = pattern;
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    fs::remove_all(path_, ignored);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
 
 ScenarioOptions noisy() {
   ScenarioOptions options;
@@ -118,7 +101,7 @@ TEST(scenario_effects, NullValuesReproduceTheRecordingWithoutEffect) {
 
 TEST(scenario_effects, TheRecordingNeverMentionsTheEffect) {
   for (const std::string& effect : effect_names()) {
-    TempDir dir;
+    test_support::TempDir dir("pliant_effects_");
     ScenarioOptions options = with_effect(noisy(), effect);
     options.occlusion = 0.05;
     write_scenario(make_scenario("ring_squeeze", options), dir.path().string());
