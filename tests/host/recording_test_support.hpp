@@ -4,50 +4,31 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
-#include <atomic>
-#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <string>
 #include <system_error>
 
 #include "pliant/host/recording.hpp"
+#include "../support/temp_dir.hpp"
 
 namespace pliant::host::test {
 
-/// A fresh directory under the system temporary directory, removed with its contents on
-/// destruction.
-class TempDir {
+/// A scratch directory (tests/support/temp_dir.hpp) that can also write files into itself.
+class TempDir : public test_support::TempDir {
  public:
-  TempDir() {
-    static std::atomic<unsigned> counter{0};
-    const auto stamp = std::chrono::steady_clock::now().time_since_epoch().count();
-    path_ = std::filesystem::temp_directory_path() /
-            ("pliant-recording-test-" + std::to_string(::getpid()) + "-" + std::to_string(stamp) +
-             "-" + std::to_string(counter++));
-    std::filesystem::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    std::filesystem::remove_all(path_, ignored);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
+  TempDir() : test_support::TempDir("pliant-recording-test-") {}
 
-  const std::filesystem::path& path() const { return path_; }
-  std::string str() const { return path_.string(); }
+  std::string str() const { return path().string(); }
 
   /// Writes `text` to `relative` (parent directories created) and returns its full path.
   std::filesystem::path write(const std::string& relative, const std::string& text) const {
-    const std::filesystem::path file = path_ / relative;
+    const std::filesystem::path file = path() / relative;
     std::filesystem::create_directories(file.parent_path());
     std::ofstream out(file, std::ios::binary);
     out << text;
     return file;
   }
-
- private:
-  std::filesystem::path path_;
 };
 
 /// Runs `action` and returns the RecordingError message it throws, "<no error>" when it
