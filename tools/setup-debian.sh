@@ -8,6 +8,9 @@ packages=(
   libeigen3-dev                  # core linear algebra (the only core dependency)
   nlohmann-json3-dev             # recording and result JSON (host)
   libcli11-dev                   # the pliant command line
+  libtet1.5-dev                  # TetGen: tetrahedralize closed surfaces (host FEM)
+  libspectra-dev                 # sparse eigenvalues: FEM modal analysis and warm starts
+  libceres-dev                   # Levenberg-Marquardt material estimation (host FEM)
   libgtest-dev                   # unit tests
   libbenchmark-dev               # bench/
   clang libclang-rt-14-dev       # libFuzzer targets and their sanitizer runtimes
