@@ -1,0 +1,88 @@
+// Bounded, robust nonlinear least squares for material estimation (Ceres Levenberg-Marquardt),
+// with parameter uncertainty. The FEM estimators (Young's modulus, Rayleigh damping, rest shape,
+// material maps) describe their parameters and hand over a residual function that runs the
+// model; this file owns everything about the optimisation itself.
+//
+// Host code: allocates, may throw std::invalid_argument on a malformed problem. Not real-time.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+namespace pliant::host::fem {
+
+/// One scalar unknown. `lower < initial < upper` (strictly inside: the optimiser starts there).
+/// With `log_scale` the optimiser works on log(value): steps are relative, the value stays
+/// positive (lower must be > 0), and a start 10x off costs as many iterations as one 10x low.
+/// Use it for moduli and damping coefficients; use a linear scale for signed quantities.
+struct FitParameter {
+  std::string name;  ///< reported name, a parameter name from the recording spec where one fits
+  double initial = 1.0;
+  double lower = 0.0;
+  double upper = 1.0;
+  bool log_scale = true;
+};
+
+/// Residual function: given the parameter values (same order as the FitParameter list), fill
+/// `residuals` (already sized to the problem's residual count). Residuals should be whitened by
+/// the caller (divided by their measurement noise) so that the robust loss scale and the
+/// reported uncertainty mean what they say; unwhitened residuals still fit, and the uncertainty
+/// then uses the residual scatter instead (see FitResult::residual_sigma). Return false when the
+/// model cannot be evaluated at these values (solver failure, inverted elements): the optimiser
+/// treats that step as rejected and shrinks its trust region.
+using ResidualFunction =
+    std::function<bool(const std::vector<double>& values, std::vector<double>& residuals)>;
+
+enum class RobustLoss {
+  none,    ///< plain least squares
+  huber,   ///< quadratic within loss_scale, linear beyond (default: mild outliers)
+  cauchy,  ///< log growth beyond loss_scale (heavy outliers, e.g. tracking glitches)
+};
+
+struct FitOptions {
+  RobustLoss loss = RobustLoss::huber;
+  /// Residual magnitude where the robust loss bends, in residual units. 0 means automatic: a
+  /// first pass without the loss, then robust passes (at most four) with the bend at 2.5 x the
+  /// robust (MAD) residual scatter of the previous solution, until that scale changes < 5 %.
+  double loss_scale = 0.0;
+  int max_iterations = 60;          ///< per pass
+  double function_tolerance = 1e-10;  ///< relative cost decrease that ends a pass
+  double parameter_tolerance = 1e-9;  ///< relative step that ends a pass
+  /// Central-difference step for the Jacobian: in log space for log-scale parameters (a
+  /// relative step), as a fraction of (upper - lower) for linear ones. Residual functions that
+  /// solve iteratively must converge well below this step's effect.
+  double difference_step = 1e-4;
+  /// Called after every iteration with (pass, iteration, cost); may be empty.
+  std::function<void(int, int, double)> on_iteration;
+};
+
+struct FitResult {
+  std::vector<std::string> names;
+  std::vector<double> values;
+  /// One standard deviation per parameter from the Gauss-Newton covariance at the solution
+  /// (robust weights applied), scaled by residual_sigma^2; NaN when the Jacobian is rank
+  /// deficient in that direction (the data do not determine the parameter).
+  std::vector<double> standard_deviations;
+  Eigen::MatrixXd covariance;  ///< in parameter units (log-scale parameters mapped back)
+  double initial_cost = 0.0;   ///< 0.5 * sum r^2 at the initial values
+  double final_cost = 0.0;     ///< 0.5 * sum r^2 at the solution (no robust loss)
+  /// sqrt(sum w r^2 / (m - n)): the scatter of the residuals about the fit, in residual units;
+  /// near 1 when residuals were whitened correctly and the model fits.
+  double residual_sigma = 0.0;
+  int iterations = 0;           ///< over all passes
+  int evaluations = 0;          ///< residual function calls, including Jacobian differences
+  bool converged = false;       ///< a tolerance was met (not the iteration limit)
+  std::vector<bool> at_bound;   ///< per parameter: ended within 1e-6 (relative) of a bound
+  std::string message;          ///< the optimiser's own summary line
+};
+
+/// Minimises the (robustified) sum of squared residuals over the bounded parameters.
+/// Throws std::invalid_argument when a parameter's bounds or initial value are inconsistent,
+/// residual_count < 1, or the residual function fails at the initial values.
+FitResult fit_least_squares(const std::vector<FitParameter>& parameters, int residual_count,
+                            const ResidualFunction& residuals, const FitOptions& options = {});
+
+}  // namespace pliant::host::fem
