@@ -1,9 +1,14 @@
 #!/usr/bin/env bash
-# Builds the recording fuzzer (tests/fuzz/recording_fuzz.cpp) with clang and runs it for
-# ${PLIANT_FUZZ_SECONDS:-60} seconds from a small seed corpus. Exits non-zero when the build
-# fails or the fuzzer finds a crash, a sanitizer error, a leak, a timeout or an out-of-memory.
+# Builds the recording fuzzer (tests/fuzz/recording_fuzz.cpp) and the mesh fuzzer
+# (tests/fuzz/mesh_fuzz.cpp) with clang and runs them for ${PLIANT_FUZZ_SECONDS:-60} and
+# ${PLIANT_MESH_FUZZ_SECONDS:-30} seconds from small seed corpora. Exits non-zero when the build
+# fails or a fuzzer finds a crash, a sanitizer error, a leak, a timeout or an out-of-memory.
 #
-# Environment: PLIANT_FUZZ_SECONDS (default 60), PLIANT_FUZZ_BUILD_DIR (default build-fuzz),
+# The compression-test CSV fuzzer (tests/fuzz/compression_csv_fuzz.cpp) follows for
+# ${PLIANT_CSV_FUZZ_SECONDS:-30} seconds.
+#
+# Environment: PLIANT_FUZZ_SECONDS (default 60), PLIANT_MESH_FUZZ_SECONDS (default 30),
+# PLIANT_CSV_FUZZ_SECONDS (default 30), PLIANT_FUZZ_BUILD_DIR (default build-fuzz),
 # CXX_FUZZ (default clang++).
 set -euo pipefail
 
@@ -18,7 +23,7 @@ cmake -S "$root" -B "$build" \
   -DPLIANT_BUILD_TESTS=ON \
   -DPLIANT_BUILD_HOST=OFF \
   -DPLIANT_BUILD_BENCHMARKS=OFF
-cmake --build "$build" --target recording_fuzz -j "$(nproc)"
+cmake --build "$build" --target recording_fuzz mesh_fuzz compression_csv_fuzz -j "$(nproc)"
 
 fuzzer="$build/bin/recording_fuzz"
 [ -x "$fuzzer" ] || fuzzer="$(find "$build" -type f -name recording_fuzz -perm -u+x | head -n 1)"
@@ -46,4 +51,76 @@ printf '%s\0%b\0%b' "$json3d" "$csv3d" "$offsets" > "$corpus/seed-3d-offsets"
   -timeout=10 \
   -rss_limit_mb=2048 \
   -artifact_prefix="$artifacts/" \
+  -print_final_stats=1
+
+# Mesh readers. The first byte of an input picks the reader (tests/fuzz/mesh_fuzz.cpp): 0 MSH,
+# 1 TetGen (.node NUL .ele), 2 OBJ, 3 PLY, 4 STL, 5 all. Seeds: a gmsh file from the examples, a
+# binary MSH 4.1, TetGen, OBJ, ASCII and binary PLY, ASCII and binary STL.
+mesh_fuzzer="$build/bin/mesh_fuzz"
+[ -x "$mesh_fuzzer" ] || mesh_fuzzer="$(find "$build" -type f -name mesh_fuzz -perm -u+x | head -n 1)"
+mesh_corpus="$build/fuzz/mesh-corpus"
+mesh_artifacts="$build/fuzz/mesh-artifacts"
+mkdir -p "$mesh_corpus" "$mesh_artifacts"
+# Escape text for one little-endian value (bytes 0-255 only); the outer printf turns it into bytes.
+u64() { printf '\\x%02x\\x00\\x00\\x00\\x00\\x00\\x00\\x00' "$1"; }
+i32() { printf '\\x%02x\\x00\\x00\\x00' "$1"; }
+f64() { if [ "$1" = 1 ]; then printf '\\x00\\x00\\x00\\x00\\x00\\x00\\xf0\\x3f'; else printf '\\x00%.0s' 1 2 3 4 5 6 7 8; fi; }
+f32() { if [ "$1" = 1 ]; then printf '\\x00\\x00\\x80\\x3f'; else printf '\\x00%.0s' 1 2 3 4; fi; }
+{ printf '\0'; cat "$root/examples/meshes/tetmesh_ipc/bar-6.msh"; } > "$mesh_corpus/seed-msh41"
+printf '\0$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n$EndNodes\n$Elements\n2\n1 2 2 0 1 1 2 3\n2 4 2 0 1 1 2 3 4\n$EndElements\n' \
+  > "$mesh_corpus/seed-msh22"
+{
+  printf '\0$MeshFormat\n4.1 1 8\n'; printf "$(i32 1)"; printf '\n$EndMeshFormat\n$Nodes\n'
+  printf "$(u64 1)$(u64 4)$(u64 1)$(u64 4)$(i32 3)$(i32 1)$(i32 0)$(u64 4)"
+  printf "$(u64 1)$(u64 2)$(u64 3)$(u64 4)"
+  printf "$(f64 0)$(f64 0)$(f64 0)$(f64 1)$(f64 0)$(f64 0)$(f64 0)$(f64 1)$(f64 0)$(f64 0)$(f64 0)$(f64 1)"
+  printf '\n$EndNodes\n$Elements\n'
+  printf "$(u64 1)$(u64 1)$(u64 1)$(u64 1)$(i32 3)$(i32 1)$(i32 4)$(u64 1)$(u64 1)$(u64 1)$(u64 2)$(u64 3)$(u64 4)"
+  printf '\n$EndElements\n'
+} > "$mesh_corpus/seed-msh41-binary"
+printf '\1# nodes\n5 3 1 1\n0 0 0 0 1.5 1\n1 1 0 0 1.5 1\n2 0 1 0 1.5 0\n3 0 0 1 1.5 1\n4 1 1 1 0 0\n\0# tets\n2 4 1\n0 0 1 2 3 1\n1 1 4 2 3 2\n' \
+  > "$mesh_corpus/seed-tetgen"
+printf '\2v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvt 0 0\nvn 0 0 1\nf 1/1/1 3/1/1 2/1/1\nf 1//1 2//1 4//1\nf -4 -1 -2\nf 2 3 4 # quad\n' \
+  > "$mesh_corpus/seed-obj"
+printf '\3ply\nformat ascii 1.0\ncomment x\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n' \
+  > "$mesh_corpus/seed-ply"
+{
+  printf '\3ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n'
+  printf "$(f32 0)$(f32 0)$(f32 0)$(f32 1)$(f32 0)$(f32 0)$(f32 0)$(f32 1)$(f32 0)$(f32 0)$(f32 0)$(f32 1)"
+  printf "\\x03$(i32 0)$(i32 2)$(i32 1)\\x03$(i32 0)$(i32 1)$(i32 3)\\x03$(i32 0)$(i32 3)$(i32 2)\\x03$(i32 1)$(i32 2)$(i32 3)"
+} > "$mesh_corpus/seed-ply-binary"
+printf '\4solid t\nfacet normal 0 0 -1\nouter loop\nvertex 0 0 0\nvertex 0 1 0\nvertex 1 0 0\nendloop\nendfacet\nendsolid t\n' \
+  > "$mesh_corpus/seed-stl"
+{
+  printf '\4'; printf ' %.0s' $(seq 80); printf "$(i32 1)"
+  printf "$(f32 0)$(f32 0)$(f32 1)$(f32 0)$(f32 0)$(f32 0)$(f32 1)$(f32 0)$(f32 0)$(f32 0)$(f32 1)$(f32 0)"
+  printf '\0\0'
+} > "$mesh_corpus/seed-stl-binary"
+
+"$mesh_fuzzer" "$mesh_corpus" \
+  -dict="$root/tests/fuzz/mesh_fuzz.dict" \
+  -max_total_time="${PLIANT_MESH_FUZZ_SECONDS:-30}" \
+  -max_len=8192 \
+  -timeout=10 \
+  -rss_limit_mb=2048 \
+  -artifact_prefix="$mesh_artifacts/" \
+  -print_final_stats=1
+
+# Compression-test CSV parser and converter. Seeds: the head of a phantom test file, and a file
+# with other units, columns in another order, CRLF line endings and a byte-order mark.
+csv_fuzzer="$build/bin/compression_csv_fuzz"
+[ -x "$csv_fuzzer" ] || csv_fuzzer="$(find "$build" -type f -name compression_csv_fuzz -perm -u+x | head -n 1)"
+csv_corpus="$build/fuzz/compression-csv-corpus"
+csv_artifacts="$build/fuzz/compression-csv-artifacts"
+mkdir -p "$csv_corpus" "$csv_artifacts"
+head -n 40 "$root/examples/phantom_compression/source/EF10_0T_B5.csv" > "$csv_corpus/seed-phantom"
+printf '\357\273\277Sample: cyl-7;\r\nDiameter (mm): 50\r\nheight: 0.03 m\r\nSpeed: 0.5 mm/s\r\nLoad cell: 1kN\r\nTime (ms),Load (kN),Compression (m),Note,True Stress (MPa)\r\n0,0,0,a,0\r\n500,0.002,0.001,b,0.1\r\n1000,0.004,0.002,c,0.2\r\n' \
+  > "$csv_corpus/seed-units"
+
+"$csv_fuzzer" "$csv_corpus" \
+  -max_total_time="${PLIANT_CSV_FUZZ_SECONDS:-30}" \
+  -max_len=8192 \
+  -timeout=10 \
+  -rss_limit_mb=2048 \
+  -artifact_prefix="$csv_artifacts/" \
   -print_final_stats=1

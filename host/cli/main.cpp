@@ -6,6 +6,7 @@
 
 #include "command_diagnose.hpp"
 #include "command_estimate.hpp"
+#include "command_import.hpp"
 #include "command_simulate.hpp"
 #include "exit_status.hpp"
 
@@ -38,6 +39,7 @@ int run(int argc, char** argv) {
   EstimateCommand estimate(app);
   SimulateCommand simulate(app);
   DiagnoseCommand diagnose(app);
+  ImportCommand importer(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& done) {  // --help, --version
@@ -48,6 +50,7 @@ int run(int argc, char** argv) {
   if (estimate.selected()) return run_reporting_errors("pliant estimate", [&] { return estimate.run(); });
   if (simulate.selected()) return run_reporting_errors("pliant simulate", [&] { return simulate.run(); });
   if (diagnose.selected()) return run_reporting_errors("pliant diagnose", [&] { return diagnose.run(); });
+  if (importer.selected()) return run_reporting_errors("pliant import compression", [&] { return importer.run(); });
   std::cerr << app.help();
   return exit_usage;
 }
