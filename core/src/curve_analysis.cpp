@@ -21,6 +21,10 @@ ParabolaFit fit_parabola(double x0, double h, double left, double centre, double
   return fit;
 }
 
+double second_difference(double x0, double f0, double x1, double f1, double x2, double f2) noexcept {
+  return 2.0 * ((f2 - f1) / (x2 - x1) - (f1 - f0) / (x1 - x0)) / (x2 - x0);
+}
+
 bool single_basin(const double* values, int count, double prominence) noexcept {
   if (count < 1) return false;
   int best = 0;

@@ -72,34 +72,64 @@ int gather_targets(const ObservationSequence<Dim, Scalar>& obs, int k, const Msm
   return count;
 }
 
-// Adds frame k's residuals of free observed particles to `error`.
+// True when every coordinate of every frame is finite: then no residual needs the observed()
+// test (checked once per estimate rather than per particle, frame and evaluation).
+template <int Dim, typename Scalar>
+bool all_observed(const ObservationSequence<Dim, Scalar>& obs) noexcept {
+  const long scalars = static_cast<long>(obs.frame_count) * obs.particle_count * Dim;
+  bool finite = true;
+  for (long j = 0; j < scalars; ++j) finite &= std::isfinite(obs.positions[j]);
+  return finite;
+}
+
+// Adds frame k's residuals of free observed particles to `error` (kAllObserved: the caller has
+// checked that every observation is finite).
 // With `residual_sum` ([particle_count]) and `samples` it also sums each particle's residuals
 // over frames, from which the estimator measures how much of the residual persists in time.
-template <int Dim, typename Scalar>
+template <bool kAllObserved, int Dim, typename Scalar>
 void accumulate_frame(const MsmModel<Dim, Scalar>& model, const ObservationSequence<Dim, Scalar>& obs, int k,
                       const MsmState<Dim, Scalar>& state, Eigen::Matrix<double, Dim, 1>* residual_sum,
                       double* samples, TrajectoryError& error) noexcept {
+  // Hot loop of every evaluation (once per frame): plain arrays and local sums, so that nothing
+  // is reloaded through the output pointers. Same arithmetic, in the same order, as
+  // (position - observation).cast<double>() and its squaredNorm.
   long used = 0;
-  for (int i = 0; i < model.particle_count; ++i) {
-    if (model.fixed[i] != 0 || state.driven_now[i] != 0 || !obs.observed(k, i)) continue;
-    const Eigen::Matrix<double, Dim, 1> residual = (state.position[i] - obs.point(k, i)).template cast<double>();
-    const double squared = residual.squaredNorm();
-    error.sum_squares += squared;
-    error.mean_distance += std::sqrt(squared);
+  double sum_squares = error.sum_squares;
+  double distance = error.mean_distance;
+  const std::uint8_t* fixed = model.fixed;
+  const std::uint8_t* driven = state.driven_now;
+  const Eigen::Matrix<Scalar, Dim, 1>* position = state.position;
+  const Scalar* observed = obs.at(k, 0);
+  const int n = model.particle_count;
+  for (int i = 0; i < n; ++i, observed += Dim) {
+    if ((fixed[i] | driven[i]) != 0) continue;
+    bool finite = true;
+    double residual[static_cast<std::size_t>(Dim)];
+    for (int d = 0; d < Dim; ++d) {
+      if constexpr (!kAllObserved) finite = finite && std::isfinite(observed[d]);
+      residual[d] = static_cast<double>(position[i](d) - observed[d]);
+    }
+    if (!finite) continue;
+    double squared = residual[0] * residual[0];
+    for (int d = 1; d < Dim; ++d) squared += residual[d] * residual[d];
+    sum_squares += squared;
+    distance += std::sqrt(squared);
     ++used;
     if (residual_sum != nullptr) {
-      residual_sum[i] += residual;
+      for (int d = 0; d < Dim; ++d) residual_sum[i](d) += residual[d];
       samples[i] += 1.0;
     }
   }
+  error.sum_squares = sum_squares;
+  error.mean_distance = distance;
   if (used == 0) ++error.frames_without_observations;
   error.count += used;
 }
 
 template <int Dim, typename Scalar>
 void run_trajectory(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>& params,
-                    const ObservationSequence<Dim, Scalar>& obs, DeformabilityWorkspace<Dim, Scalar>& ws,
-                    TrajectoryError& error) noexcept {
+                    const ObservationSequence<Dim, Scalar>& obs, bool observed_everywhere,
+                    DeformabilityWorkspace<Dim, Scalar>& ws, TrajectoryError& error) noexcept {
   MsmState<Dim, Scalar>& state = ws.state;
   msm_state_reset(model, state);
   for (int w = 0; w < obs.driven_count; ++w) ws.window_active[w] = 0;
@@ -115,7 +145,11 @@ void run_trajectory(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Sca
     input.driven.ids = ws.target_ids;
     input.driven.positions = ws.targets;
     (void)msm_step(model, params, input, state);
-    accumulate_frame(model, obs, k, state, ws.residual_sum, ws.residual_samples, error);
+    if (observed_everywhere) {
+      accumulate_frame<true>(model, obs, k, state, ws.residual_sum, ws.residual_samples, error);
+    } else {
+      accumulate_frame<false>(model, obs, k, state, ws.residual_sum, ws.residual_samples, error);
+    }
   }
   for (int i = 0; i < model.particle_count; ++i) {
     if (ws.residual_samples[i] > 0) {
@@ -176,16 +210,44 @@ void run_final(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>&
       break;
     }
   }
-  accumulate_frame(model, obs, obs.frame_count - 1, state, static_cast<Eigen::Matrix<double, Dim, 1>*>(nullptr),
+  accumulate_frame<false>(model, obs, obs.frame_count - 1, state, static_cast<Eigen::Matrix<double, Dim, 1>*>(nullptr),
                    nullptr, error);
 }
 
+// Whether the curvature of the sum of squares at the estimate may come from the refinement's
+// own samples next to it (a second difference over ~tolerance / 4), which spares the two probes
+// 0.01 either side. That difference is small (S'' d^2 ~ 1e-5 S at the default tolerance), so
+// it needs errors that are smooth in beta to far below that: trajectory mode in double.
+// In float the simulation's rounding makes E(beta) rough at ~1e-5 relative, and the final mode
+// warm-starts each relaxation from the last and stops it at equilibrium_tolerance; both keep
+// the probes.
+template <typename Scalar>
+bool local_curvature_possible(const DeformabilityConfig& config) noexcept {
+  return config.mode == FitMode::trajectory && sizeof(Scalar) >= sizeof(double);
+}
+
+// evaluate_deformability_error with all_observed(obs) known.
+template <int Dim, typename Scalar>
+Status evaluate_error(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>& params,
+                      const ObservationSequence<Dim, Scalar>& obs, const DeformabilityConfig& config,
+                      bool observed_everywhere, DeformabilityWorkspace<Dim, Scalar>& ws, TrajectoryError& error) noexcept {
+  error = TrajectoryError{};
+  if (config.mode == FitMode::trajectory) {
+    run_trajectory(model, params, obs, observed_everywhere, ws, error);
+  } else {
+    run_final(model, params, obs, config, ws, error);
+  }
+  if (error.count == 0) return Status::no_observations;
+  error.mean_distance /= static_cast<double>(error.count);
+  return Status::ok;
+}
+
 // Evaluations one beta search plans: grid, Brent steps (bounded by the golden-section count,
-// which Brent's fallback never exceeds by more than a few), two curvature probes.
-int planned_search_evaluations(const DeformabilityConfig& config) noexcept {
+// which Brent's fallback never exceeds by more than a few), two curvature probes when needed.
+int planned_search_evaluations(const DeformabilityConfig& config, bool probes) noexcept {
   const double bracket = 2.0 / (config.grid_points - 1);
   const int golden = static_cast<int>(std::ceil(std::log(bracket / config.tolerance) / std::log(1.618034)));
-  return config.grid_points + std::min(golden, config.max_refinements) + 2;
+  return config.grid_points + std::min(golden, config.max_refinements) + (probes ? 2 : 0);
 }
 
 struct Minimum {
@@ -225,13 +287,18 @@ Minimum golden_section_minimum(F&& f, double lo, double hi, double tolerance, in
 // (here the neighbouring grid samples, so the first step is already a parabola through three
 // samples). Stops when the bracket around x is narrower than `tolerance` on both sides or after
 // `max_evaluations` calls of f.
+// A parabolic step that would land within 2 tol1 of a bracket end becomes a step of tol1; Brent
+// takes it toward the bracket's middle. With `smooth` (f smooth, as the trajectory error is)
+// it goes the parabola's way instead unless that side is already closed: when the minimum lies
+// between x and the near end, that one sample both improves x and closes the bracket, where
+// the step toward the middle costs a sample on the far side first. The estimate is the same.
 struct Point {
   double x = 0;
   double value = 0;
 };
 template <typename F>
 Minimum brent_minimum(F&& f, double a, double b, Point x, Point w, Point v, double tolerance,
-                      int max_evaluations) noexcept {
+                      int max_evaluations, bool smooth) noexcept {
   constexpr double kGolden = 0.38196601125010515;  // (3 - sqrt 5) / 2
   const double tol1 = 0.25 * tolerance;
   double step = 0.0;           // last step taken
@@ -254,7 +321,17 @@ Minimum brent_minimum(F&& f, double a, double b, Point x, Point w, Point v, doub
       if (q > 0.0 && std::abs(p) < std::abs(0.5 * q * before) && p > q * (a - x.x) && p < q * (b - x.x)) {
         step = p / q;
         const double u = x.x + step;
-        if (u - a < 2.0 * tol1 || b - u < 2.0 * tol1) step = middle >= x.x ? tol1 : -tol1;
+        if (u - a < 2.0 * tol1 || b - u < 2.0 * tol1) {
+          if (!smooth) {
+            step = middle >= x.x ? tol1 : -tol1;
+          } else if (b - x.x <= 2.0 * tol1) {
+            step = -tol1;
+          } else if (x.x - a <= 2.0 * tol1) {
+            step = tol1;
+          } else {
+            step = step >= 0.0 ? tol1 : -tol1;
+          }
+        }
         parabolic = true;
       }
     }
@@ -297,12 +374,13 @@ struct Sample {
   TrajectoryError error;
 };
 
-// One beta search at fixed alpha. Records the curve in the workspace when `record` is set.
+// One beta search at fixed alpha. Records the curve in the workspace when `record` is set;
+// without `uncertainty` only the estimate and its error are filled in (the msm_alpha profile).
 template <int Dim, typename Scalar>
 Status search_beta(const MsmModel<Dim, Scalar>& model, MsmParams<Dim, Scalar> params,
                    const ObservationSequence<Dim, Scalar>& obs, const DeformabilityConfig& config,
-                   DeformabilityWorkspace<Dim, Scalar>& ws, bool record, Progress& progress,
-                   DeformabilityResult& result) noexcept {
+                   bool observed_everywhere, DeformabilityWorkspace<Dim, Scalar>& ws, bool record, bool uncertainty,
+                   Progress& progress, DeformabilityResult& result) noexcept {
   int curve = 0;
   Sample best{0, {}};
   best.error.mean_distance = std::numeric_limits<double>::infinity();
@@ -311,14 +389,15 @@ Status search_beta(const MsmModel<Dim, Scalar>& model, MsmParams<Dim, Scalar> pa
   auto evaluate = [&](double beta) -> TrajectoryError {
     params.msm_beta = static_cast<Scalar>(beta);
     TrajectoryError error;
-    (void)evaluate_deformability_error(model, params, obs, config, ws, error);
+    (void)evaluate_error(model, params, obs, config, observed_everywhere, ws, error);
     ++evaluations;
     progress.tick();
     if (!error.converged) ++result.unconverged_equilibria;
     if (error.count > 0) any_observed = true;
-    if (record && curve < ws.curve_capacity) {
+    if (curve < ws.curve_capacity) {
       ws.curve_beta[curve] = beta;
       ws.curve_error[curve] = error.mean_distance;
+      ws.curve_sum_squares[curve] = error.count > 0 ? error.sum_squares : std::numeric_limits<double>::quiet_NaN();
       ++curve;
     }
     if (error.count > 0 && error.mean_distance < best.error.mean_distance) best = Sample{beta, error};
@@ -357,17 +436,45 @@ Status search_beta(const MsmModel<Dim, Scalar>& model, MsmParams<Dim, Scalar> pa
   Point near_better = best_grid > 0 ? grid_point(best_grid - 1) : grid_point(best_grid + 2);
   Point near_worse = best_grid < grid - 1 ? grid_point(best_grid + 1) : grid_point(best_grid - 2);
   if (near_worse.value < near_better.value) std::swap(near_better, near_worse);
+  // The trajectory error is a mean over every frame, smooth in beta; the final mode's has few
+  // residuals and relaxations stopped at a tolerance.
+  const bool smooth = config.mode == FitMode::trajectory;
   (void)brent_minimum([&](double beta) { return evaluate(beta).mean_distance; }, lo, hi, grid_point(best_grid),
-                      near_better, near_worse, config.tolerance, config.max_refinements);
+                      near_better, near_worse, config.tolerance, config.max_refinements, smooth);
 
-  // Uncertainty from the curvature of the sum of squares around the estimate: the estimate
-  // itself and one probe either side (the centre moves inward only at a bound).
+  // Uncertainty from the curvature of the sum of squares at the estimate. Brent leaves samples
+  // within tolerance / 2 on both sides of it; where E is smooth enough (see
+  // local_curvature_possible) their second difference is the curvature. Otherwise, or when
+  // those neighbours are missing (the estimate at a bound, refinement cut short), the estimate
+  // itself and one probe h either side (the centre moves inward only at a bound).
   const double h = std::max(0.01, 2.0 * config.tolerance);
-  const double centre = std::clamp(best.beta, h, 1.0 - h);
-  const TrajectoryError left = evaluate(centre - h);
-  const TrajectoryError middle = std::abs(centre - best.beta) < 1e-15 ? best.error : evaluate(centre);
-  const TrajectoryError right = evaluate(centre + h);
-  const ParabolaFit fit = fit_parabola(centre, h, left.sum_squares, middle.sum_squares, right.sum_squares);
+  double curvature = 0;
+  bool have_curvature = false;
+  if (uncertainty && local_curvature_possible<Scalar>(config)) {
+    // Nearest samples either side, not closer than kMinSpacing (the difference must not vanish
+    // in rounding) nor farther than h (it must stay local).
+    constexpr double kMinSpacing = 1e-5;
+    int below = -1;
+    int above = -1;
+    for (int i = 0; i < std::min(curve, ws.curve_capacity); ++i) {
+      const double offset = ws.curve_beta[i] - best.beta;
+      if (!std::isfinite(ws.curve_sum_squares[i]) || std::abs(offset) < kMinSpacing || std::abs(offset) > h) continue;
+      if (offset < 0 && (below < 0 || offset > ws.curve_beta[below] - best.beta)) below = i;
+      if (offset > 0 && (above < 0 || offset < ws.curve_beta[above] - best.beta)) above = i;
+    }
+    if (below >= 0 && above >= 0) {
+      curvature = second_difference(ws.curve_beta[below], ws.curve_sum_squares[below], best.beta,
+                                    best.error.sum_squares, ws.curve_beta[above], ws.curve_sum_squares[above]);
+      have_curvature = true;
+    }
+  }
+  if (uncertainty && !have_curvature) {
+    const double centre = std::clamp(best.beta, h, 1.0 - h);
+    const TrajectoryError left = evaluate(centre - h);
+    const TrajectoryError middle = std::abs(centre - best.beta) < 1e-15 ? best.error : evaluate(centre);
+    const TrajectoryError right = evaluate(centre + h);
+    curvature = fit_parabola(centre, h, left.sum_squares, middle.sum_squares, right.sum_squares).curvature;
+  }
   const long scalars = best.error.count * Dim;
 
   result.msm_beta = best.beta;
@@ -386,25 +493,29 @@ Status search_beta(const MsmModel<Dim, Scalar>& model, MsmParams<Dim, Scalar> pa
       result.residual_correlation = icc;
     }
   }
-  result.msm_beta_std = least_squares_std(best.error.sum_squares, fit.curvature, scalars) * std::sqrt(design_effect);
-  result.unique_minimum = grid_single && fit.curvature > 0;
+  result.msm_beta_std = least_squares_std(best.error.sum_squares, curvature, scalars) * std::sqrt(design_effect);
+  result.unique_minimum = grid_single && curvature > 0;
   result.error = best.error.mean_distance;
   result.residual_count = best.error.count;
   result.rms = best.error.count > 0 ? std::sqrt(best.error.sum_squares / static_cast<double>(scalars)) : 0.0;
   result.evaluations += evaluations;
   if (record) {
     // Insertion sort: the curve is small (grid + refinements) and must be ascending in beta.
+    curve = std::min(curve, ws.curve_capacity);
     for (int i = 1; i < curve; ++i) {
       const double kb = ws.curve_beta[i];
       const double ke = ws.curve_error[i];
+      const double ks = ws.curve_sum_squares[i];
       int j = i - 1;
       while (j >= 0 && ws.curve_beta[j] > kb) {
         ws.curve_beta[j + 1] = ws.curve_beta[j];
         ws.curve_error[j + 1] = ws.curve_error[j];
+        ws.curve_sum_squares[j + 1] = ws.curve_sum_squares[j];
         --j;
       }
       ws.curve_beta[j + 1] = kb;
       ws.curve_error[j + 1] = ke;
+      ws.curve_sum_squares[j + 1] = ks;
     }
     result.curve_count = curve;
   }
@@ -444,6 +555,7 @@ Status deformability_workspace_init(Arena& arena, const MsmModel<Dim, Scalar>& m
   ws.curve_capacity = config.grid_points + config.max_refinements + 4;
   ws.curve_beta = arena.carve<double>(static_cast<std::size_t>(ws.curve_capacity));
   ws.curve_error = arena.carve<double>(static_cast<std::size_t>(ws.curve_capacity));
+  ws.curve_sum_squares = arena.carve<double>(static_cast<std::size_t>(ws.curve_capacity));
   ws.grid_capacity = config.grid_points;
   ws.grid_error = arena.carve<double>(static_cast<std::size_t>(config.grid_points));
   if (arena.exhausted() || state_status != Status::ok) return Status::capacity_exceeded;
@@ -456,15 +568,8 @@ Status evaluate_deformability_error(const MsmModel<Dim, Scalar>& model, const Ms
                                     const ObservationSequence<Dim, Scalar>& observations,
                                     const DeformabilityConfig& config, DeformabilityWorkspace<Dim, Scalar>& workspace,
                                     TrajectoryError& error) noexcept {
-  error = TrajectoryError{};
-  if (config.mode == FitMode::trajectory) {
-    run_trajectory(model, params, observations, workspace, error);
-  } else {
-    run_final(model, params, observations, config, workspace, error);
-  }
-  if (error.count == 0) return Status::no_observations;
-  error.mean_distance /= static_cast<double>(error.count);
-  return Status::ok;
+  return evaluate_error(model, params, observations, config,
+                        config.mode == FitMode::trajectory && all_observed(observations), workspace, error);
 }
 
 template <int Dim, typename Scalar>
@@ -476,20 +581,22 @@ Status estimate_deformability(const MsmModel<Dim, Scalar>& model, const MsmParam
   if (valid != Status::ok) return valid;
   Progress progress;
   progress.config = &config;
-  progress.planned = planned_search_evaluations(config);
+  const bool probes = !local_curvature_possible<Scalar>(config);
+  const bool observed_everywhere = config.mode == FitMode::trajectory && all_observed(observations);
+  progress.planned = planned_search_evaluations(config, probes);
   if (!config.estimate_alpha || config.mode != FitMode::trajectory) {
-    return search_beta(model, base, observations, config, workspace, true, progress, result);
+    return search_beta(model, base, observations, config, observed_everywhere, workspace, true, true, progress, result);
   }
   // msm_alpha: coarse grid, then golden-section on the profile min_beta E(alpha, beta).
   DeformabilityConfig inner = config;
   inner.grid_points = std::min(config.grid_points, 6);
   inner.tolerance = std::max(config.tolerance, 5e-3);
-  progress.planned = (5 + 14) * planned_search_evaluations(inner) + planned_search_evaluations(config);
+  progress.planned = (5 + 14) * planned_search_evaluations(inner, false) + planned_search_evaluations(config, probes);
   MsmParams<Dim, Scalar> params = base;
   auto profile = [&](double alpha) -> double {
     params.msm_alpha = static_cast<Scalar>(alpha);
     DeformabilityResult trial;
-    const Status s = search_beta(model, params, observations, inner, workspace, false, progress, trial);
+    const Status s = search_beta(model, params, observations, inner, observed_everywhere, workspace, false, false, progress, trial);
     result.evaluations += trial.evaluations;
     return s == Status::ok ? trial.error : std::numeric_limits<double>::infinity();
   };
@@ -512,10 +619,8 @@ Status estimate_deformability(const MsmModel<Dim, Scalar>& model, const MsmParam
   const Minimum refined = golden_section_minimum(profile, lo, hi, 5e-3, 14);
   if (refined.value < best_value) best_alpha = refined.x;
   params.msm_alpha = static_cast<Scalar>(best_alpha);
-  const int spent = result.evaluations;
-  const Status status = search_beta(model, params, observations, config, workspace, true, progress, result);
-  result.evaluations += spent;
-  return status;
+  // search_beta adds its evaluations to those of the profile already in result.evaluations.
+  return search_beta(model, params, observations, config, observed_everywhere, workspace, true, true, progress, result);
 }
 
 #define PLIANT_INSTANTIATE_DEFORMABILITY(DIM, SCALAR)                                                        \

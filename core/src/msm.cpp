@@ -94,8 +94,10 @@ PLIANT_INLINE void cluster_apq(const Scalar* sum, const Scalar* rest_centroid, S
 // Newton step (no special case) but not yet below the tolerance is continued by the scalar
 // extract_rotation from there, and a lane that meets a special case (zero or non-finite A_pq,
 // a warm start off the unit sphere, an ascent or clamped step) is redone by it from its warm
-// start. Each lane therefore does the same arithmetic as the scalar code: results do not depend
-// on the batching.
+// start. In 2D the rotation is closed form and needs no warm start; only a lane whose A_pq
+// carries no rotational information (or is not finite) goes to the scalar extract_rotation,
+// which keeps the previous rotation. Each lane therefore does the same arithmetic as the scalar
+// code: results do not depend on the batching.
 template <int Dim, typename Scalar>
 void elastic_cluster_pass(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>& params,
                           MsmState<Dim, Scalar>& state) noexcept {
@@ -104,7 +106,7 @@ void elastic_cluster_pass(const MsmModel<Dim, Scalar>& model, const MsmParams<Di
   constexpr int kBatch = kMsmClusterBatch;
   constexpr int kMoment = Dim * (Dim + 1);
   constexpr int kMat = Dim * Dim;
-  constexpr int kWarm = 4;  // 3D quaternion (w, x, y, z); 2D rotation matrix, column-major
+  constexpr int kWarm = 4;  // 3D quaternion (w, x, y, z); unused in 2D
   constexpr int kFields = kMsmClusterLaneFields<Dim>;
   // Array extents (unsigned, as -Wsign-conversion wants them).
   constexpr auto kBatchN = static_cast<std::size_t>(kBatch);
@@ -128,7 +130,7 @@ void elastic_cluster_pass(const MsmModel<Dim, Scalar>& model, const MsmParams<Di
     alignas(64) Scalar sum[kMomentN][kBatchN];
     alignas(64) Scalar apq[kMatN][kBatchN];
     alignas(64) Scalar guard[kBatchN];
-    alignas(64) Scalar warm[kWarmN][kBatchN];      // warm start, then the result
+    alignas(64) Scalar warm[kWarmN][kBatchN];      // 3D: warm start, then the result
     alignas(64) Scalar rotation[kMatN][kBatchN];   // its matrix, then the result's
     alignas(64) Scalar turned[kWarmN][kBatchN];    // 3D: after the first Newton iteration
     alignas(64) Scalar turned_rotation[kMatN][kBatchN];
@@ -136,13 +138,7 @@ void elastic_cluster_pass(const MsmModel<Dim, Scalar>& model, const MsmParams<Di
     alignas(64) Scalar converged[kBatchN];
     alignas(64) Scalar status[kBatchN];  // 0 special case, 1 first step plain, 2 also converged
     alignas(64) Scalar goal[kMomentN][kBatchN];
-    for (int lane = 0; lane < kBatch; ++lane) {
-      if (lane >= count) {  // padding: a copy of lane 0, computed and discarded
-        for (int e = 0; e < kMoment; ++e) sum[e][lane] = sum[e][0];
-        for (int e = 0; e < kWarm; ++e) warm[e][lane] = warm[e][0];
-        if (params.cluster_beta != nullptr) beta[lane] = beta[0];
-        continue;
-      }
+    for (int lane = 0; lane < count; ++lane) {
       const int c = first + lane;
       Moment moment;
       gather_sum(state.moment, model.member_byte_offset, model.cluster_begin[c], model.cluster_begin[c + 1], moment);
@@ -153,10 +149,15 @@ void elastic_cluster_pass(const MsmModel<Dim, Scalar>& model, const MsmParams<Di
         warm[1][lane] = q.x();
         warm[2][lane] = q.y();
         warm[3][lane] = q.z();
-      } else {
-        for (int e = 0; e < kWarm; ++e) warm[e][lane] = state.rotation[c].data()[e];
-      }
+      }  // 2D needs no warm start: its rotation is closed form
       if (params.cluster_beta != nullptr) beta[lane] = params.cluster_beta[c];
+    }
+    for (int lane = count; lane < kBatch; ++lane) {  // padding: a copy of lane 0, computed and discarded
+      for (int e = 0; e < kMoment; ++e) sum[e][lane] = sum[e][0];
+      if constexpr (Dim == 3) {
+        for (int e = 0; e < kWarm; ++e) warm[e][lane] = warm[e][0];
+      }
+      if (params.cluster_beta != nullptr) beta[lane] = beta[0];
     }
     // A_pq and the rotation's starting point, lane-wise.
     for (int lane = 0; lane < kBatch; ++lane) {
@@ -198,7 +199,6 @@ void elastic_cluster_pass(const MsmModel<Dim, Scalar>& model, const MsmParams<Di
         r[1] = si;
         r[2] = -si;
         r[3] = co;
-        for (int e = 0; e < kWarm; ++e) warm[e][lane] = r[e];
       }
       for (int e = 0; e < kMat; ++e) rotation[e][lane] = r[e];
       status[lane] = ok ? Scalar(2) : Scalar(0);
@@ -239,8 +239,14 @@ void elastic_cluster_pass(const MsmModel<Dim, Scalar>& model, const MsmParams<Di
       for (int lane = 0; lane < kBatch; ++lane) status[lane] = plain_step[lane] * (Scalar(1) + converged[lane]);
     }
     // Lanes done lane-wise take the result of the first iteration; the scalar code finishes
-    // the others from where they are.
-    for (int lane = 0; lane < count; ++lane) {
+    // the others from where they are. (2D: only lanes that met a special case, usually none.)
+    bool scalar_lanes = true;
+    if constexpr (Dim == 2) {
+      Scalar lowest = status[0];
+      for (int lane = 1; lane < kBatch; ++lane) lowest = std::min(lowest, status[lane]);
+      scalar_lanes = lowest == Scalar(0);
+    }
+    for (int lane = 0; scalar_lanes && lane < count; ++lane) {
       const Scalar lane_status = status[lane];
       if constexpr (Dim == 3) {
         if (lane_status == Scalar(2)) {
@@ -272,7 +278,6 @@ void elastic_cluster_pass(const MsmModel<Dim, Scalar>& model, const MsmParams<Di
         Mat previous = state.rotation[c];
         (void)extract_rotation(a, previous);
         r = previous;
-        for (int e = 0; e < kWarm; ++e) warm[e][lane] = r.data()[e];
       }
       for (int e = 0; e < kMat; ++e) rotation[e][lane] = r.data()[e];
     }
@@ -307,7 +312,7 @@ void elastic_cluster_pass(const MsmModel<Dim, Scalar>& model, const MsmParams<Di
         q.y() = warm[2][lane];
         q.z() = warm[3][lane];
       } else {
-        for (int e = 0; e < kWarm; ++e) state.rotation[c].data()[e] = warm[e][lane];
+        for (int e = 0; e < kMat; ++e) state.rotation[c].data()[e] = rotation[e][lane];  // 2D: the rotation itself
       }
     }
   }
@@ -449,25 +454,23 @@ Status msm_step(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>
   }
 
   const bool pinned = !finite(params.support_friction);
-  // 1. Prediction (eqs. 1-2).
-  const Scalar keep = std::max(Scalar(0), Scalar(1) - params.velocity_damping * dt);
-  for (int i = 0; i < n; ++i) {
-    const Vec& x = state.position[i];
-    state.driven_now[i] = 0;
-    if (model.fixed[i] != 0 && pinned) {
-      state.predicted[i] = model.rest[i];
-      continue;
-    }
-    Vec acceleration = params.gravity;
-    if (input.external_force != nullptr) acceleration += input.external_force[i] / model.mass[i];
-    const Vec v = (state.velocity[i] + dt * acceleration) * keep;
-    state.predicted[i] = x + dt * v;
-  }
+  // Locals for the hot loops: the compiler cannot tell that the state's arrays do not alias
+  // the model and the parameters, so members read inside the loops would be reloaded.
+  Vec* const position = state.position;
+  Vec* const predicted = state.predicted;
+  const Vec* const velocity = state.velocity;
+  std::uint8_t* const driven_now = state.driven_now;
+  const std::uint8_t* const fixed = model.fixed;
+  const Vec* const rest = model.rest;
+  const Scalar* const mass = model.mass;
+  // 1. Prediction (eqs. 1-2). Driven targets first (they replace the prediction), so that one
+  // pass predicts the others and sums the step's mean position in particle order.
+  for (int i = 0; i < n; ++i) driven_now[i] = 0;
   Status result = Status::ok;
   for (int k = 0; k < input.driven.count; ++k) {
     const int id = input.driven.ids[k];
     const Vec& target = input.driven.positions[k];
-    if (id < 0 || id >= n || model.drivable[id] == 0 || model.fixed[id] != 0) {
+    if (id < 0 || id >= n || model.drivable[id] == 0 || fixed[id] != 0) {
       ++state.dropped_targets;
       result = Status::non_finite_input;
       continue;
@@ -476,13 +479,31 @@ Status msm_step(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>
       // Fail safe: the contact particle holds where it was rather than falling free.
       ++state.dropped_targets;
       result = Status::non_finite_input;
-      state.predicted[id] = state.position[id];
-      state.driven_now[id] = 1;
+      predicted[id] = position[id];
+      driven_now[id] = 1;
       continue;
     }
-    state.predicted[id] = target;
-    state.driven_now[id] = 1;
+    predicted[id] = target;
+    driven_now[id] = 1;
   }
+  const Scalar keep = std::max(Scalar(0), Scalar(1) - params.velocity_damping * dt);
+  const Vec gravity = params.gravity;
+  const Vec* const external_force = input.external_force;
+  Vec origin = Vec::Zero();
+  for (int i = 0; i < n; ++i) {
+    if (driven_now[i] == 0) {
+      if (fixed[i] != 0 && pinned) {
+        predicted[i] = rest[i];
+      } else {
+        Vec acceleration = gravity;
+        if (external_force != nullptr) acceleration += external_force[i] / mass[i];
+        const Vec v = (velocity[i] + dt * acceleration) * keep;
+        predicted[i] = position[i] + dt * v;
+      }
+    }
+    origin += predicted[i];
+  }
+  origin /= static_cast<Scalar>(n);
 
   // 2. Cluster shape matching (eqs. 3-13). With q0 = r - r_c and sum m q0 = 0,
   // A_pq = sum m x q0^T = sum m x r^T - (sum m x) r_c^T: per-particle moments [m x r^T | m x]
@@ -490,18 +511,22 @@ Status msm_step(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>
   // Coordinates are taken relative to the mean rest position and the step's mean position so
   // that the cancellation in that difference stays small in float.
   using Moment = Eigen::Matrix<Scalar, Dim, Dim + 1>;
-  Vec origin = Vec::Zero();
-  for (int i = 0; i < n; ++i) origin += state.predicted[i];
-  origin /= static_cast<Scalar>(n);
+  Scalar origin_of[static_cast<std::size_t>(Dim)];
+  Scalar rest_origin[static_cast<std::size_t>(Dim)];
+  for (int d = 0; d < Dim; ++d) {
+    origin_of[d] = origin(d);
+    rest_origin[d] = model.rest_origin(d);
+  }
+  Moment* const moments = state.moment;
   for (int i = 0; i < n; ++i) {
-    const Scalar mass = model.mass[i];
+    const Scalar m = mass[i];
     Scalar mx[static_cast<std::size_t>(Dim)];
     Scalar r[static_cast<std::size_t>(Dim)];
     for (int d = 0; d < Dim; ++d) {
-      mx[d] = mass * (state.predicted[i](d) - origin(d));
-      r[d] = model.rest[i](d) - model.rest_origin(d);
+      mx[d] = m * (predicted[i](d) - origin_of[d]);
+      r[d] = rest[i](d) - rest_origin[d];
     }
-    Scalar* moment = state.moment[i].data();
+    Scalar* moment = moments[i].data();
     for (int col = 0; col < Dim; ++col) {
       for (int row = 0; row < Dim; ++row) moment[col * Dim + row] = mx[row] * r[col];
     }
@@ -557,36 +582,40 @@ Status msm_step(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>
 
   // 3. Integration (eqs. 10-11) with goals averaged over each particle's clusters.
   const Scalar inverse_dt = Scalar(1) / dt;
+  const Scalar alpha = params.msm_alpha;
+  const Scalar* const inverse_cluster_count = model.inverse_cluster_count;
+  const std::int32_t* const particle_cluster_begin = model.particle_cluster_begin;
+  const std::int32_t* const particle_cluster_offset = model.particle_cluster_byte_offset;
+  const Moment* const goal_maps = state.cluster_goal_map;
+  Vec* const velocity_out = state.velocity;
   for (int i = 0; i < n; ++i) {
-    const Vec previous = state.position[i];
+    const Vec previous = position[i];
     Vec next;
-    if (model.fixed[i] != 0 && pinned) {
-      next = model.rest[i];
-    } else if (state.driven_now[i] != 0) {
-      next = state.predicted[i];  // the goal of a driven particle is its target
-    } else if (model.inverse_cluster_count[i] > Scalar(0)) {
+    if (fixed[i] != 0 && pinned) {
+      next = rest[i];
+    } else if (driven_now[i] != 0) {
+      next = predicted[i];  // the goal of a driven particle is its target
+    } else if (inverse_cluster_count[i] > Scalar(0)) {
       Moment map_sum;
-      gather_sum(state.cluster_goal_map, model.particle_cluster_byte_offset, model.particle_cluster_begin[i],
-                 model.particle_cluster_begin[i + 1], map_sum);
+      gather_sum(goal_maps, particle_cluster_offset, particle_cluster_begin[i], particle_cluster_begin[i + 1], map_sum);
       // Mean goal: (sum of G) r + (sum of b), over the clusters holding i.
       const Scalar* g = map_sum.data();
       Scalar r[static_cast<std::size_t>(Dim)];
-      for (int d = 0; d < Dim; ++d) r[d] = model.rest[i](d) - model.rest_origin(d);
-      const Scalar inverse_count = model.inverse_cluster_count[i];
-      const Scalar alpha = params.msm_alpha;
+      for (int d = 0; d < Dim; ++d) r[d] = rest[i](d) - rest_origin[d];
+      const Scalar inverse_count = inverse_cluster_count[i];
       for (int row = 0; row < Dim; ++row) {
         Scalar goal = g[row] * r[0];
         for (int k = 1; k < Dim; ++k) goal += g[k * Dim + row] * r[k];
         goal = (goal + g[Dim * Dim + row]) * inverse_count;
-        const Scalar x = state.predicted[i](row);
-        next(row) = x + alpha * (origin(row) + goal - x);
+        const Scalar x = predicted[i](row);
+        next(row) = x + alpha * (origin_of[row] + goal - x);
       }
     } else {
-      next = state.predicted[i];
+      next = predicted[i];
     }
-    if (model.fixed[i] != 0 && !pinned) next = support_contact(params, model.rest[i], previous, next);
-    state.position[i] = next;
-    state.velocity[i] = (next - previous) * inverse_dt;
+    if (fixed[i] != 0 && !pinned) next = support_contact(params, rest[i], previous, next);
+    position[i] = next;
+    velocity_out[i] = (next - previous) * inverse_dt;
   }
   state.time_s += static_cast<double>(dt);
   ++state.steps;

@@ -12,6 +12,10 @@ struct ParabolaFit {
 };
 ParabolaFit fit_parabola(double x0, double h, double left, double centre, double right) noexcept;
 
+/// Second derivative of the parabola through three samples at x0 < x1 < x2 (any spacing):
+/// twice the second divided difference.
+double second_difference(double x0, double f0, double x1, double f1, double x2, double f2) noexcept;
+
 /// True when the sampled curve has a single basin: every other local minimum is separated from
 /// the global one by a barrier lower than `prominence` x (max - min). A flat curve (range below
 /// 1e-12 relative) has no unique minimum. `values` has `count` >= 1 entries on ascending x.

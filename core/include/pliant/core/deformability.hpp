@@ -14,10 +14,14 @@
 // Search: E on a uniform grid over [0, 1], then Brent refinement (parabolic steps through the
 // samples, golden-section steps where a parabola is unsafe) inside the best grid point's
 // neighbours until the bracket is below `tolerance`; bounded by grid_points + max_refinements
-// + 2 evaluations (x ~10 with estimate_alpha). Typically 6-8 refinement steps. Uncertainty: curvature of the sum of squared
-// residuals at the minimum (curve_analysis.hpp), widened by the design effect of residuals that
-// persist per particle over time (each particle's frames are one correlated cluster). unique_minimum is false when the grid curve
-// has a second basin, is flat, or the curvature is not positive.
+// + 2 evaluations (x ~10 with estimate_alpha). Typically 5-7 refinement steps. Uncertainty:
+// curvature of the sum of squared residuals at the minimum (curve_analysis.hpp), widened by the
+// design effect of residuals that persist per particle over time (each particle's frames are one
+// correlated cluster). In trajectory mode with Scalar = double the curvature is the second
+// difference through the refinement's own samples next to the estimate (within tolerance / 2);
+// in float, in the final mode (whose E is not smooth at that scale) or when such samples are
+// missing, two more evaluations 0.01 either side give it. unique_minimum is false when the grid
+// curve has a second basin, is flat, or the curvature is not positive.
 //
 // Real-time contract: the workspace is sized once (deformability_workspace_size) and carved
 // at init; estimate_deformability allocates nothing and throws nothing. Its cost is bounded by
@@ -81,6 +85,7 @@ struct DeformabilityWorkspace {
   int curve_capacity = 0;
   double* curve_beta = nullptr;  ///< [curve_capacity] E(beta) samples of the last estimate
   double* curve_error = nullptr; ///< [curve_capacity]
+  double* curve_sum_squares = nullptr;  ///< [curve_capacity] sum of squared residuals per sample
   double* grid_error = nullptr;  ///< [grid_capacity] scratch: E on the uniform grid
   int grid_capacity = 0;
 };
