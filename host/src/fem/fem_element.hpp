@@ -1,0 +1,66 @@
+// Element kernels shared by the model functions and the solvers (private to the host library).
+#pragma once
+
+#include <array>
+
+#include <Eigen/Core>
+
+#include "pliant/host/fem/fem_model.hpp"
+
+namespace pliant::host::fem::detail {
+
+using Mat34 = Eigen::Matrix<double, 3, 4>;
+
+/// F = sum_a x_a b_a^T for corner positions taken from a 3n array.
+inline Eigen::Matrix3d gather_gradient(const double* x, const std::array<int, 4>& nodes, const Mat34& b) {
+  Eigen::Matrix3d f = Eigen::Matrix3d::Zero();
+  for (int a = 0; a < 4; ++a) {
+    const Eigen::Map<const Eigen::Vector3d> xa(x + 3 * nodes[static_cast<std::size_t>(a)]);
+    f.noalias() += xa * b.col(a).transpose();
+  }
+  return f;
+}
+
+/// World-frame stress-like tensor of the element: P = R sigma(sym(R^T F) - I), so the corner
+/// forces are -V P b_a. Also returns the strain energy density through `energy_density`.
+inline Eigen::Matrix3d corotated_stress(const Eigen::Matrix3d& f, const Eigen::Matrix3d& r, double mu, double lambda,
+                                        double* energy_density) {
+  Eigen::Matrix3d strain = r.transpose() * f;
+  strain = 0.5 * (strain + strain.transpose());
+  strain.diagonal().array() -= 1.0;
+  const double trace = strain.trace();
+  if (energy_density != nullptr) *energy_density = mu * strain.squaredNorm() + 0.5 * lambda * trace * trace;
+  Eigen::Matrix3d sigma = 2.0 * mu * strain;
+  sigma.diagonal().array() += lambda * trace;
+  return r * sigma;
+}
+
+/// Product of the rotated element stiffness R K_e R^T with corner vectors w_a, written as
+/// out_a = V s c_a with c = R b (rotated gradients), s = mu (H + H^T) + lambda tr(H) I and
+/// H = sum_a w_a c_a^T. Adds into `out` (3n array).
+inline void add_rotated_stiffness_product(const Mat34& c, double volume, double mu, double lambda, const double* w,
+                                          const std::array<int, 4>& nodes, double scale, double* out) {
+  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+  for (int a = 0; a < 4; ++a) {
+    const Eigen::Map<const Eigen::Vector3d> wa(w + 3 * nodes[static_cast<std::size_t>(a)]);
+    h.noalias() += wa * c.col(a).transpose();
+  }
+  Eigen::Matrix3d s = mu * (h + h.transpose());
+  s.diagonal().array() += lambda * h.trace();
+  const Mat34 contribution = (scale * volume) * (s * c);
+  for (int a = 0; a < 4; ++a) {
+    Eigen::Map<Eigen::Vector3d> oa(out + 3 * nodes[static_cast<std::size_t>(a)]);
+    oa += contribution.col(a);
+  }
+}
+
+/// Block (a, b) of R K_e R^T: V (lambda c_a c_b^T + mu c_b c_a^T + mu (b_a . b_b) I).
+inline Eigen::Matrix3d rotated_stiffness_block(const Mat34& c, const Mat34& b, int ia, int ib, double volume, double mu,
+                                               double lambda) {
+  Eigen::Matrix3d k = (volume * lambda) * c.col(ia) * c.col(ib).transpose() +
+                      (volume * mu) * c.col(ib) * c.col(ia).transpose();
+  k.diagonal().array() += volume * mu * b.col(ia).dot(b.col(ib));
+  return k;
+}
+
+}  // namespace pliant::host::fem::detail
