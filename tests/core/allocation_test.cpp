@@ -40,7 +40,9 @@
 #include <type_traits>
 #include <vector>
 
+#include "core/grasp_guard_fixture.hpp"
 #include "pliant/core/deformability.hpp"
+#include "pliant/core/grasp_guard.hpp"
 #include "pliant/core/msm.hpp"
 #include "pliant/core/msm_model.hpp"
 #include "pliant/core/observations.hpp"
@@ -764,6 +766,120 @@ TYPED_TEST(RealTimeAllocation, EvaluateDeformabilityError) {
   EXPECT_GT(at_truth.count, 0);
   EXPECT_LT(at_truth.mean_distance, at_wrong.mean_distance);
   EXPECT_TRUE(at_final.converged);
+}
+
+// The grasp guard's real-time calls: grasp_guard_update over a grasp that goes through ok,
+// limit and stop (a squeeze past the predicted safe closure, NaN and bus-off faults, a stale
+// camera, a frozen wrench, slip), grasp_guard_measure_strain per camera frame (one with an
+// unobserved particle), the prediction queries, acknowledge and reset.
+TYPED_TEST(RealTimeAllocation, GraspGuard) {
+  using Scalar = typename TestFixture::FixtureScalar;
+  using Vec = typename TestFixture::FixtureVec;
+  constexpr int Dim = TestFixture::kFixtureDim;
+  test::GuardedObject<Dim, Scalar> object(test::lattice<Dim, Scalar>(6, 4, 3, 0.005));
+  GraspGuardConfig config;
+  config.nominal_force_n = 4;
+  config.prediction_beta_points = 6;
+  config.prediction_closure_points = 12;
+  config.wrench_frozen_samples = 50;
+  ASSERT_EQ(object.build_guard(config), Status::ok);
+  GraspGuard<Dim, Scalar>& guard = object.guard;
+  const double safe = grasp_guard_strain_safe_closure(guard, 0.3, 0.5);
+  ASSERT_GT(safe, 0.0);
+
+  // The whole scenario, prepared before arming.
+  constexpr int kCycles = 2000;
+  std::vector<GraspGuardInput> inputs(kCycles);
+  for (int k = 0; k < kCycles; ++k) {
+    GraspGuardInput& in = inputs[static_cast<std::size_t>(k)];
+    const double t = 1.0 + 1e-3 * k;
+    const double closure = k < 1000 ? std::min(1.3 * safe, safe * k / 600.0) : 0.5 * safe;
+    in.now_s = t;
+    in.gripper = GripperSample{};
+    in.gripper.stamp_s = t;
+    in.gripper.width_m = 0.03 - closure;
+    in.gripper.force_n = 1.0 + 1000 * closure;
+    in.gripper.valid = true;
+    in.gripper.bus_off = k >= 1100 && k < 1110;
+    if (k >= 1200 && k < 1205) in.gripper.width_m = std::numeric_limits<double>::quiet_NaN();
+    in.wrench.stamp_s = t;
+    in.wrench.valid = true;
+    const bool slipping = k >= 1300 && k < 1500;
+    const bool frozen = k >= 1600 && k < 1700;
+    for (int d = 0; d < 6; ++d) in.wrench.wrench[d] = frozen ? 0.5 : 0.5 + 1e-4 * std::sin(0.3 * k + d);
+    if (slipping) in.wrench.wrench[1] += 0.5 * std::sin(2 * 3.14159265358979 * 40 * 1e-3 * k);
+    const bool camera_live = !(k >= 1800 && k < 1950);
+    in.deformation.stamp_s = camera_live ? t - 0.02 : 1.0 + 1e-3 * 1799 - 0.02;
+    in.deformation.strain = 0.01;
+    in.deformation.valid = true;
+    in.estimate.stamp_s = t;
+    in.estimate.msm_beta = 0.4;
+    in.estimate.msm_beta_std = k < 100 ? std::numeric_limits<double>::infinity() : 0.05;
+    in.estimate.valid = true;
+  }
+  std::vector<GraspGuardOutput> outputs(kCycles);
+  std::vector<Status> statuses(kCycles, Status::not_initialized);
+  std::vector<Vec> squeezed(static_cast<std::size_t>(object.particle_count()));
+  for (int i = 0; i < object.particle_count(); ++i) {
+    squeezed[static_cast<std::size_t>(i)] = object.model.rest[i];
+    squeezed[static_cast<std::size_t>(i)](0) *= Scalar(0.95);
+  }
+  std::vector<Vec> occluded = squeezed;
+  occluded[3](1) = std::numeric_limits<Scalar>::quiet_NaN();
+  GraspStrainMeasurement measured, partial;
+  Status measured_status = Status::not_initialized, partial_status = Status::not_initialized;
+  double predicted = 0, safe_closure = 0;
+  GraspGuardOutput after_reset;
+  Status after_reset_status = Status::not_initialized;
+
+  AllocationCounts counts;
+  {
+    AllocationCounter counter;
+    for (int k = 0; k < kCycles; ++k) {
+      const auto u = static_cast<std::size_t>(k);
+      if (k % 33 == 0) {
+        measured_status = grasp_guard_measure_strain(object.model, guard, squeezed.data(), measured);
+        partial_status = grasp_guard_measure_strain(object.model, guard, occluded.data(), partial);
+      }
+      statuses[u] = grasp_guard_update(guard, inputs[u], outputs[u]);
+      if (k == 1150) grasp_guard_acknowledge_stop(guard);
+    }
+    predicted = grasp_guard_predicted_strain(guard, 0.5 * safe, 0.0, 1.0);
+    safe_closure = grasp_guard_strain_safe_closure(guard, 0.2, 0.6);
+    grasp_guard_reset(guard);
+    GraspGuardInput next = inputs[kCycles - 1];
+    next.now_s += 1e-3;
+    next.gripper.stamp_s = next.now_s;
+    after_reset_status = grasp_guard_update(guard, next, after_reset);
+    counts = counter.stop();
+  }
+  EXPECT_NO_HEAP(counts, "grasp guard update / measure_strain / reset");
+  int seen[3] = {0, 0, 0};
+  bool slip = false;
+  for (int k = 0; k < kCycles; ++k) {
+    const auto u = static_cast<std::size_t>(k);
+    EXPECT_EQ(statuses[u], Status::ok) << k;
+    ++seen[static_cast<int>(outputs[u].verdict)];
+    slip = slip || outputs[u].slip;
+  }
+  // The scenario really exercised every verdict and the slip cue.
+  EXPECT_GT(seen[static_cast<int>(GraspVerdict::ok)], 0);
+  EXPECT_GT(seen[static_cast<int>(GraspVerdict::limit)], 0);
+  EXPECT_GT(seen[static_cast<int>(GraspVerdict::stop)], 0);
+  EXPECT_TRUE(slip);
+  EXPECT_EQ(outputs[700].reason, GuardReason::predicted_strain);
+  EXPECT_TRUE(outputs[1650].reasons & (1u << static_cast<unsigned>(GuardReason::stale_wrench)));
+  EXPECT_EQ(outputs[1900].reason, GuardReason::stale_camera);
+  EXPECT_EQ(measured_status, Status::ok);
+  EXPECT_NEAR(measured.strain, 0.05, 1e-3);
+  EXPECT_EQ(partial_status, Status::ok);
+  EXPECT_GT(partial.clusters_skipped, 0);
+  EXPECT_GT(predicted, 0.0);
+  EXPECT_GT(safe_closure, 0.0);
+  EXPECT_EQ(after_reset_status, Status::ok);
+  // A new grasp: contact is re-detected at the current width, so the closure starts from 0.
+  EXPECT_DOUBLE_EQ(after_reset.closure_m, 0.0);
+  EXPECT_DOUBLE_EQ(after_reset.allowed_force_n, config.nominal_force_n);
 }
 
 }  // namespace
