@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Every test: install what is missing, build, run the unit, integration and install tests, then
-# the same unit tests under AddressSanitizer + UndefinedBehaviorSanitizer, then a one-minute
-# libFuzzer smoke run of every parser. Usage: bash tools/test.sh
+# Every test: install what is missing, build, run the unit, integration, acceptance and install
+# tests, then all but the slow acceptance runs (ctest label) under AddressSanitizer +
+# UndefinedBehaviorSanitizer, then a short libFuzzer smoke run of every parser.
+# Usage: bash tools/test.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc)
@@ -16,7 +17,7 @@ echo "== AddressSanitizer + UndefinedBehaviorSanitizer"
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPLIANT_SANITIZE=ON -DPLIANT_BUILD_BENCHMARKS=OFF > /dev/null
 cmake --build build-asan -j"$jobs"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-  ctest --test-dir build-asan -j"$jobs" --output-on-failure -E 'install_consumer|concealed_suite'
+  ctest --test-dir build-asan -j"$jobs" --output-on-failure -LE acceptance -E install_consumer
 
 echo "== libFuzzer smoke run"
 bash .ci/fuzz_smoke.sh

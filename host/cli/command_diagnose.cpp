@@ -23,7 +23,9 @@ DiagnoseCommand::DiagnoseCommand(CLI::App& parent) {
   app_->add_option("--json", json_path_, "Also write the pliant-diagnosis v1 JSON to OUT; '-' prints it instead")
       ->type_name("OUT");
   app_->add_option("--report", report_dir_, "Write an HTML report with plots to DIR/index.html")->type_name("DIR");
-  app_->add_option("--model", model_, "Baseline model (fem arrives with the FEM work)")
+  app_->add_option("--model", model_,
+                   "Baseline model: msm (shape matching) or fem (corotational linear FEM; needs a 3D recording "
+                   "in metres with mesh.vtk)")
       ->type_name("msm|fem")
       ->capture_default_str();
   app_->add_flag("-q,--quiet", quiet_, "No progress bar");
@@ -31,9 +33,11 @@ DiagnoseCommand::DiagnoseCommand(CLI::App& parent) {
 
 int DiagnoseCommand::run() const {
   if (model_ != "msm" && model_ != "fem") throw UsageError("--model must be msm or fem");
-  if (model_ == "fem") throw UsageError("--model fem is not available yet; use --model msm");
   const host::Recording recording = host::read_recording(recording_);
   for (const std::string& warning : recording.warnings) report_warning(warning);
+  if (model_ == "fem" && (recording.dimension != 3 || !recording.mesh || recording.length_unit != "m")) {
+    throw UsageError("--model fem needs a 3D recording in metres with a tetrahedral mesh (mesh.vtk)");
+  }
 
   host::DiagnoseResult result;
   {

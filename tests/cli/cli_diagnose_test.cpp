@@ -1,5 +1,6 @@
 // `pliant diagnose`: the JSON contract on a simulated recording with no hidden effect, and the
-// clear refusals (malformed recording, too few frames, nothing moving).
+// clear refusals (malformed recording, too few frames, nothing moving); `--model fem` on a real
+// compression curve, and its refusals.
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
@@ -76,13 +77,92 @@ TEST(cli_diagnose, MotionlessRecordingIsRefusedNotGivenAVerdict) {
   EXPECT_TRUE(contains(r.err, "nothing moves")) << r.err;
 }
 
-TEST(cli_diagnose, FemModelIsAUsageErrorForNow) {
+// `--model fem` on real data, end to end: the Instron curve of a silicone phantom (the source of
+// examples/phantom_compression/EF30_0T_A5) imported with a coarse cylinder mesh, then diagnosed.
+// Frictionless platens make the deformation homogeneous, so the coarse mesh gives the verdict of
+// the shipped 582-node recording (fem_diagnose_acceptance_test) in a fraction of a second.
+TEST(cli_diagnose, FemModelNamesStiffeningOnARealCompressionCurve) {
   TempDir dir;
-  const fs::path recording = dir.path() / "rec";
-  write_tiny_recording(recording);
-  const CommandResult r = run_pliant("diagnose " + quoted(recording.string()) + " --model fem");
+  const std::string recording = dir / "ef30";
+  const std::string csv = std::string(PLIANT_PHANTOM_COMPRESSION_DIR) + "/source/EF30_0T_A5.csv";
+  ASSERT_EQ(run_pliant("import compression " + quoted(csv) + " -o " + quoted(recording) + " --mesh-divisions 1,8,2")
+                .status,
+            0);
+  const std::string report = dir / "report";
+  const CommandResult r =
+      run_pliant("diagnose " + quoted(recording) + " --model fem -q --json - --report " + quoted(report));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("format"), "pliant-diagnosis");
+  EXPECT_EQ(j.at("version"), 1);
+  EXPECT_EQ(j.at("verdict"), "missing_physics");
+  EXPECT_EQ(j.at("effect"), "stiffening");
+  EXPECT_EQ(j.at("baseline").at("model"), "fem");
+  EXPECT_EQ(j.at("augmented").at("model"), "fem");
+  // Force only: no free node position is compared, so the v1 rms keys are null and the force
+  // keys carry the fit.
+  EXPECT_TRUE(j.at("baseline").at("rms").is_null());
+  EXPECT_TRUE(j.at("noise_rms").is_null());
+  const double before = j.at("baseline").at("force_rms").get<double>();
+  const double after = j.at("augmented").at("force_rms").get<double>();
+  EXPECT_GT(before, 50.0);  // newtons: the linear FEM misses a 763 N curve badly
+  EXPECT_LT(after, 0.25 * before);
+  EXPECT_NEAR(j.at("improvement").get<double>(), 1.0 - after / before, 1e-9);
+  EXPECT_GT(j.at("force_noise_rms").get<double>(), 0.0);
+  for (const char* key : {"youngs_modulus", "poisson_ratio", "density"}) {
+    EXPECT_TRUE(j.at("baseline").at("parameters").contains(key)) << key;
+  }
+  EXPECT_GT(j.at("augmented").at("parameters").at("stiffening").get<double>(), 1.0);
+  EXPECT_FALSE(j.at("explanation").get<std::string>().empty());
+  ASSERT_FALSE(j.at("candidates").empty());
+  EXPECT_EQ(j.at("candidates").at(0).at("effect"), "stiffening");
+  for (const auto& c : j.at("candidates")) {
+    for (const char* key : {"effect", "rms", "bic", "parameters", "force_rms"}) EXPECT_TRUE(c.contains(key)) << key;
+  }
+  EXPECT_TRUE(fs::exists(fs::path(report) / "index.html"));
+  EXPECT_TRUE(contains(read_text(fs::path(report) / "index.html"), "data-plot=\"force\""));
+
+  // Without --json -: the summary names the effect and the force fit before and after.
+  const std::string out = dir / "diagnosis.json";
+  const CommandResult summary = run_pliant("diagnose " + quoted(recording) + " --model fem -q --json " + quoted(out));
+  ASSERT_EQ(summary.status, 0) << summary.err;
+  EXPECT_TRUE(contains(summary.out, "missing_physics (stiffening)")) << summary.out;
+  EXPECT_TRUE(contains(summary.out, "held-out force rms")) << summary.out;
+  EXPECT_EQ(nlohmann::json::parse(read_text(out)), j);
+}
+
+TEST(cli_diagnose, FemModelWithoutAMeshIsAUsageErrorOnOneLine) {
+  TempDir dir;
+  // 2D, no mesh.
+  const fs::path flat = dir.path() / "flat";
+  write_tiny_recording(flat);
+  const std::string json = dir / "out.json";
+  const CommandResult r = run_pliant("diagnose " + quoted(flat.string()) + " --model fem -q --json " + quoted(json));
   EXPECT_EQ(r.status, 2);
-  EXPECT_TRUE(contains(r.err, "fem")) << r.err;
+  ASSERT_EQ(r.err_lines().size(), 1u) << r.err;
+  EXPECT_TRUE(contains(r.err, "--model fem needs a 3D recording")) << r.err;
+  EXPECT_FALSE(fs::exists(json));
+  // 3D in metres, every particle observed, but no mesh.
+  const fs::path solid = dir.path() / "solid";
+  fs::create_directories(solid);
+  write_text(solid / "recording.json", R"({"format": "pliant-recording", "version": 1, "dimension": 3,
+    "length_unit": "m", "particles": {"count": 4, "fixed": [0, 1, 2]}, "files": {"particles": "particles.csv"}})");
+  std::string csv = "t,id,x,y,z\n";
+  for (int k = 0; k < 12; ++k) {
+    const std::string t = std::to_string(0.1 * k);
+    csv += t + ",0,0,0,0\n" + t + ",1,1,0,0\n" + t + ",2,0,1,0\n";
+    csv += t + ",3,0,0," + std::to_string(1.0 - 0.01 * k) + "\n";
+  }
+  write_text(solid / "particles.csv", csv);
+  const CommandResult no_mesh = run_pliant("diagnose " + quoted(solid.string()) + " --model fem -q");
+  EXPECT_EQ(no_mesh.status, 2);
+  ASSERT_EQ(no_mesh.err_lines().size(), 1u) << no_mesh.err;
+  EXPECT_TRUE(contains(no_mesh.err, "mesh.vtk")) << no_mesh.err;
+  EXPECT_EQ(no_mesh.out, "");
+  // An unknown model.
+  const CommandResult bogus = run_pliant("diagnose " + quoted(solid.string()) + " --model beam -q");
+  EXPECT_EQ(bogus.status, 2);
+  EXPECT_TRUE(contains(bogus.err, "--model must be msm or fem")) << bogus.err;
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "pliant/host/diagnose/effects.hpp"
+#include "pliant/host/diagnose/fem_diagnose.hpp"
 #include "pliant/host/diagnose/holdout.hpp"
 #include "pliant/host/diagnose/locate.hpp"
 #include "pliant/host/diagnose/model_run.hpp"
@@ -459,9 +460,8 @@ std::vector<double> magnitudes(const Recording& recording, const std::vector<dou
 
 DiagnoseResult diagnose_recording(const Recording& recording, const DiagnoseOptions& options) {
   const auto started = std::chrono::steady_clock::now();
-  if (options.model != "msm") {
-    throw std::runtime_error("model '" + options.model + "' is not available yet; use --model msm");
-  }
+  if (options.model == "fem") return diagnose_recording_fem(recording, options);
+  if (options.model != "msm") throw std::runtime_error("model '" + options.model + "' is unknown; use msm or fem");
   const int frames = recording.frame_count();
   const int n = recording.particle_count;
   const int dim = recording.dimension;
@@ -687,14 +687,22 @@ DiagnoseResult diagnose_recording(const Recording& recording, const DiagnoseOpti
 }
 
 nlohmann::json diagnosis_json(const Diagnosis& d) {
+  // rms NaN (no position compared, FEM on force-only recordings) is written as null; the FEM's
+  // force_rms and force_noise_rms only when they exist.
   auto model = [](const FittedModel& m) {
-    return nlohmann::json{{"model", m.model}, {"parameters", m.parameters}, {"rms", m.rms}};
+    nlohmann::json j{{"model", m.model}, {"parameters", m.parameters}, {"rms", nullptr}};
+    if (std::isfinite(m.rms)) j["rms"] = m.rms;
+    if (std::isfinite(m.force_rms)) j["force_rms"] = m.force_rms;
+    return j;
   };
   nlohmann::json candidates = nlohmann::json::array();
   for (const Candidate& c : d.candidates) {
-    candidates.push_back({{"effect", c.effect}, {"rms", c.rms}, {"bic", c.bic}, {"parameters", c.parameters}});
+    nlohmann::json j{{"effect", c.effect}, {"rms", nullptr}, {"bic", c.bic}, {"parameters", c.parameters}};
+    if (std::isfinite(c.rms)) j["rms"] = c.rms;
+    if (std::isfinite(c.force_rms)) j["force_rms"] = c.force_rms;
+    candidates.push_back(j);
   }
-  return {{"format", "pliant-diagnosis"},
+  nlohmann::json document = {{"format", "pliant-diagnosis"},
           {"version", 1},
           {"recording", d.recording},
           {"baseline", model(d.baseline)},
@@ -706,12 +714,37 @@ nlohmann::json diagnosis_json(const Diagnosis& d) {
           {"augmented", model(d.augmented)},
           {"improvement", d.improvement},
           {"candidates", candidates}};
+  if (!std::isfinite(d.noise_rms)) document["noise_rms"] = nullptr;
+  if (std::isfinite(d.force_noise_rms)) document["force_noise_rms"] = d.force_noise_rms;
+  return document;
 }
 
 std::string diagnosis_summary(const Diagnosis& d, const std::string& length_unit) {
   std::ostringstream out;
   out << d.recording << ": " << d.verdict;
   if (d.effect != "none") out << " (" << d.effect << ")";
+  if (d.baseline.model == "fem") {
+    const auto youngs = d.baseline.parameters.find("youngs_modulus");
+    out << "\n  baseline fem, E " << number(youngs != d.baseline.parameters.end() ? youngs->second : 0.0) << " Pa";
+    if (std::isfinite(d.baseline.force_rms)) {
+      out << ", held-out force rms " << number(d.baseline.force_rms) << " N (noise " << number(d.force_noise_rms) << " N)";
+    }
+    if (std::isfinite(d.baseline.rms)) {
+      out << ", held-out rms " << number(d.baseline.rms) << " " << length_unit << " (noise " << number(d.noise_rms) << " "
+          << length_unit << ")";
+    }
+    out << "\n";
+    if (d.verdict == "missing_physics" && d.effect != "unknown") {
+      out << "  with " << d.effect << ":";
+      const auto augmented_youngs = d.augmented.parameters.find("youngs_modulus");
+      if (augmented_youngs != d.augmented.parameters.end()) out << " E " << number(augmented_youngs->second) << " Pa,";
+      if (std::isfinite(d.augmented.force_rms)) out << " held-out force rms " << number(d.augmented.force_rms) << " N,";
+      if (std::isfinite(d.augmented.rms)) out << " held-out rms " << number(d.augmented.rms) << " " << length_unit << ",";
+      out << " improvement " << number(100.0 * d.improvement) << " %\n";
+    }
+    out << "  " << d.explanation << "\n";
+    return out.str();
+  }
   out << "\n  baseline msm_beta " << number(d.baseline.parameters.at("msm_beta")) << ", held-out rms "
       << number(d.baseline.rms) << " " << length_unit << ", noise " << number(d.noise_rms) << " " << length_unit << "\n";
   if (d.verdict == "missing_physics" && d.effect != "unknown") {

@@ -610,15 +610,27 @@ void header(std::string& out, const Diagnosis& d, const DiagnosisEvidence& evide
   const auto row = [&](const std::string& name, const std::string& value) {
     out += "<tr><th>" + name + "</th><td>" + value + "</td></tr>\n";
   };
-  row("measurement noise rms", escape(number(d.noise_rms, 3)) + " " + unit);
-  row("baseline rms (held-out)", escape(number(d.baseline.rms, 3)) + " " + unit +
-                                     " &nbsp; (model <code>" + escape(d.baseline.model) +
-                                     "</code>)");
-  row("augmented rms (held-out)", escape(number(d.augmented.rms, 3)) + " " + unit);
+  // FEM on a force-only recording: no free node position is compared, the force rows say it all.
+  const bool force_only = !std::isfinite(d.baseline.rms) && std::isfinite(d.baseline.force_rms);
+  if (force_only) {
+    row("model", "<code>" + escape(d.baseline.model) + "</code> &nbsp; (no free node position is compared: "
+                 "the evidence is the force)");
+  } else {
+    row("measurement noise rms", escape(number(d.noise_rms, 3)) + " " + unit);
+    row("baseline rms (held-out)", escape(number(d.baseline.rms, 3)) + " " + unit +
+                                       " &nbsp; (model <code>" + escape(d.baseline.model) +
+                                       "</code>)");
+    row("augmented rms (held-out)", escape(number(d.augmented.rms, 3)) + " " + unit);
+  }
   row("improvement", std::isfinite(d.improvement) ? escape(number(100.0 * d.improvement, 3)) + " %"
                                                   : std::string("n/a"));
   if (d.noise_rms > 0 && std::isfinite(d.baseline.rms)) {
     row("baseline rms / noise", escape(number(d.baseline.rms / d.noise_rms, 3)));
+  }
+  if (std::isfinite(d.force_noise_rms) || std::isfinite(d.baseline.force_rms)) {
+    row("force noise rms", escape(number(d.force_noise_rms, 3)) + " N");
+    row("baseline force rms (held-out)", escape(number(d.baseline.force_rms, 3)) + " N");
+    row("augmented force rms (held-out)", escape(number(d.augmented.force_rms, 3)) + " N");
   }
   row("located particles", id_list(d.location.particles));
   if (!d.location.particles.empty()) {
@@ -735,21 +747,105 @@ void trajectories_section(std::string& out, const Diagnosis& d, const DiagnosisE
   out += "</div>\n";
 }
 
+// FEM with a measured wrench: the force along its main direction (that of the largest measured
+// force) against time, measured / baseline / augmented. Nothing when there is no force.
+void force_section(std::string& out, const Diagnosis& d, const DiagnosisEvidence& evidence) {
+  const std::size_t frames = evidence.frame_times_s.size();
+  if (evidence.force_observed.empty()) return;
+  out += "<h2>Force on the tool</h2>\n";
+  if (evidence.force_observed.size() != 3 * frames || evidence.force_baseline.size() != 3 * frames ||
+      evidence.force_augmented.size() != 3 * frames) {
+    out += "<p class=\"note\">No force plot: the force arrays do not hold frames &times; 3 values.</p>\n";
+    return;
+  }
+  double direction[3] = {0, 0, 1};
+  double peak = 0;
+  for (std::size_t f = 0; f < frames; ++f) {
+    const double* v = &evidence.force_observed[3 * f];
+    const double norm = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    if (std::isfinite(norm) && norm > peak) {
+      peak = norm;
+      for (int a = 0; a < 3; ++a) direction[a] = v[a] / norm;
+    }
+  }
+  const auto along = [&](const std::vector<double>& force) {
+    std::vector<double> values(frames, kNaN);
+    for (std::size_t f = 0; f < frames; ++f) {
+      values[f] = force[3 * f] * direction[0] + force[3 * f + 1] * direction[1] + force[3 * f + 2] * direction[2];
+    }
+    return values;
+  };
+  const std::vector<double> observed = along(evidence.force_observed);
+  const std::vector<double> baseline = along(evidence.force_baseline);
+  const std::vector<double> augmented = along(evidence.force_augmented);
+  std::vector<double> xs(frames);
+  for (std::size_t f = 0; f < frames; ++f) xs[f] = evidence.frame_times_s[f];
+  double lo = std::numeric_limits<double>::infinity();
+  double hi = -lo;
+  for (const std::vector<double>* series : {&observed, &baseline, &augmented}) {
+    for (const double v : *series) {
+      if (!std::isfinite(v)) continue;
+      lo = std::min(lo, v);
+      hi = std::max(hi, v);
+    }
+  }
+  if (!(hi >= lo) || frames < 2) {
+    out += "<p class=\"note\">No force plot: no finite force values.</p>\n";
+    return;
+  }
+  const double pad = hi > lo ? 0.05 * (hi - lo) : std::max(std::fabs(hi) * 0.1, 1e-9);
+  lo -= pad;
+  hi += pad;
+  out += "<p class=\"legend\">Force of the tool on the object along the direction of the largest measured force "
+         "(" + escape(number(direction[0], 3)) + ", " + escape(number(direction[1], 3)) + ", " +
+         escape(number(direction[2], 3)) + "). <span style=\"color:" + std::string(kObservedColour) +
+         "\">&#9473; measured</span><span style=\"color:" + kBaselineColour +
+         "\">&#9476; baseline</span><span style=\"color:" + kAugmentedColour + "\">&#9473; augmented</span></p>\n";
+  const double width = 760, height = 320;
+  svg::open(out, "force", "Measured and simulated force against time", width, height);
+  svg::Area area;
+  area.left = 80;
+  area.top = 20;
+  area.width = width - 100;
+  area.height = height - 20 - 52;
+  area.x_min = xs.front();
+  area.x_max = xs.back() > xs.front() ? xs.back() : xs.front() + 1.0;
+  area.y_min = lo;
+  area.y_max = hi;
+  const auto line = [&](const std::vector<double>& values, const std::string& attributes) {
+    std::vector<double> dx, dy;
+    decimate(xs, values, dx, dy);
+    svg::polyline(out, area, dx, dy, attributes);
+  };
+  line(observed, "stroke=\"" + std::string(kObservedColour) + "\" stroke-width=\"2.2\"");
+  line(baseline, "stroke=\"" + std::string(kBaselineColour) + "\" stroke-width=\"1.5\" stroke-dasharray=\"6 3\"");
+  line(augmented, "stroke=\"" + std::string(kAugmentedColour) + "\" stroke-width=\"1.5\"");
+  svg::axes(out, area, svg::linear_ticks(area.x_min, area.x_max, 6), svg::linear_ticks(lo, hi, 5), "time (s)",
+            "force (N)");
+  svg::close(out);
+  if (d.verdict == "consistent") out += "<p class=\"note\">Consistent: the augmented curve is the baseline.</p>\n";
+}
+
 void tables_section(std::string& out, const Diagnosis& d, const DiagnosisEvidence& evidence) {
   const std::string unit = escape(unit_of(evidence));
   out += "<h2>(d) Candidate effects</h2>\n";
   if (d.candidates.empty()) {
     out += "<p class=\"note\">No candidate effects were tried.</p>\n";
   } else {
-    out += "<table data-table=\"candidates\">\n<tr><th>#</th><th>effect</th><th>held-out rms (" +
-           unit + ")</th><th>BIC</th><th>parameters (&plusmn; 1 std)</th></tr>\n";
+    // FEM with a measured wrench: a held-out force rms column too.
+    bool forces = false;
+    for (const Candidate& c : d.candidates) forces = forces || std::isfinite(c.force_rms);
+    out += "<table data-table=\"candidates\">\n<tr><th>#</th><th>effect</th><th>held-out rms (" + unit + ")</th>" +
+           (forces ? "<th>held-out force rms (N)</th>" : "") +
+           "<th>BIC</th><th>parameters (&plusmn; 1 std)</th></tr>\n";
     for (std::size_t i = 0; i < d.candidates.size(); ++i) {
       const Candidate& c = d.candidates[i];
       const bool chosen = d.verdict != "consistent" && c.effect == d.effect;
       out += std::string(chosen ? "<tr class=\"chosen\">" : "<tr>") + "<td class=\"num\">" +
              std::to_string(i + 1) + "</td><td>" + escape(c.effect) + (chosen ? " (chosen)" : "") +
-             "</td><td class=\"num\">" + escape(number(c.rms, 3)) + "</td><td class=\"num\">" +
-             escape(number(c.bic, 6)) + "</td><td>" +
+             "</td><td class=\"num\">" + escape(number(c.rms, 3)) +
+             "</td>" + (forces ? "<td class=\"num\">" + escape(number(c.force_rms, 3)) + "</td>" : std::string()) +
+             "<td class=\"num\">" + escape(number(c.bic, 6)) + "</td><td>" +
              parameter_list(c.parameters, c.parameter_std) + "</td></tr>\n";
     }
     out += "</table>\n";
@@ -833,8 +929,16 @@ std::string diagnosis_html(const Diagnosis& diagnosis, const DiagnosisEvidence& 
            std::to_string(shape.frames) + " frames and " + std::to_string(shape.particles) +
            " particles.</p>\n";
   } else {
-    maps_section(out, diagnosis, evidence, shape);
-    trajectories_section(out, diagnosis, evidence, shape);
+    force_section(out, diagnosis, evidence);
+    // Force only (FEM, no free node position compared): the maps and trajectories would show
+    // constrained nodes that follow their own observations, so they are left out.
+    if (!std::isfinite(diagnosis.baseline.rms) && !evidence.force_observed.empty()) {
+      out += "<p class=\"note\" data-note=\"force-only\">No residual maps or trajectories: no free node "
+             "position is compared with the simulation; the force above is the evidence.</p>\n";
+    } else {
+      maps_section(out, diagnosis, evidence, shape);
+      trajectories_section(out, diagnosis, evidence, shape);
+    }
   }
   tables_section(out, diagnosis, evidence);
   out +=

@@ -16,6 +16,8 @@
 // 5. Select: an effect is named only when its held-out rms improves clearly on the baseline,
 //    its BIC gain is >= 10, a parameter is >= 3 standard deviations from its null and the
 //    baseline misfit stands clearly above the noise floor; otherwise `consistent`.
+// options.model == "fem" runs the same procedure on the corotational linear FEM baseline
+// (fem_diagnose.hpp), which also compares forces and adds force_rms to the document.
 // Host code: allocates, throws std::runtime_error with one line when a recording cannot be
 // diagnosed (too few frames, nothing moves, nothing observed).
 #pragma once
@@ -31,7 +33,15 @@
 namespace pliant::host {
 
 struct DiagnoseOptions {
-  std::string model = "msm";  ///< only "msm" today; "fem" arrives with the FEM issue
+  std::string model = "msm";  ///< "msm" or "fem" (fem_diagnose.hpp: needs a 3D recording with a mesh)
+  /// FEM only: "auto" (quasi-static when the loading is slow against the lowest natural period),
+  /// "quasi_static" or "dynamic".
+  std::string fem_time = "auto";
+  /// FEM quasi-static only: solve every k-th frame (0: automatic, at most about 40 solved frames).
+  int fem_frame_stride = 0;
+  /// FEM: worker threads for the candidate fits (0: one per hardware thread, at most one per
+  /// effect). The diagnosis does not depend on it.
+  int threads = 0;
   int holdout_block_frames = 0;  ///< 0: about a tenth of a second of frames (at least 3)
   /// Progress (stage name, done, total); may be empty.
   std::function<void(const std::string&, int, int)> progress;

@@ -5,6 +5,7 @@
 // times in seconds. Host code: plain data, no behaviour.
 #pragma once
 
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -18,6 +19,9 @@ struct FittedModel {
   std::map<std::string, double> parameters;  ///< e.g. {"msm_alpha": 1, "msm_beta": 0.58}
   std::map<std::string, double> parameter_std;  ///< same keys (subset); absent: not computed
   double rms = 0;                            ///< held-out output-error rms, length_unit
+  /// FEM with a measured wrench: held-out rms of the force residual (N); NaN otherwise (then
+  /// absent from the JSON). `rms` is NaN (JSON null) when no free node position is compared.
+  double force_rms = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct Candidate {
@@ -26,6 +30,7 @@ struct Candidate {
   std::map<std::string, double> parameter_std;
   double rms = 0;   ///< held-out rms
   double bic = 0;   ///< Bayesian information criterion on the fitting frames (lower is better)
+  double force_rms = std::numeric_limits<double>::quiet_NaN();  ///< held-out force rms (N), FEM only
 };
 
 struct Location {
@@ -38,12 +43,19 @@ struct Diagnosis {
   std::string recording;  ///< recording name
   FittedModel baseline;
   double noise_rms = 0;
+  /// FEM with a measured wrench: the force noise rms (N) of the wrench stream (per-component std
+  /// times sqrt(3)); NaN otherwise (absent from the JSON).
+  double force_noise_rms = std::numeric_limits<double>::quiet_NaN();
   std::string verdict = "consistent";  ///< "consistent" or "missing_physics"
   std::string effect = "none";
   std::string explanation;
   Location location;
   FittedModel augmented;  ///< equals baseline when consistent
-  double improvement = 0;  ///< 1 - augmented.rms / baseline.rms (held-out frames)
+  /// 1 - augmented.rms / baseline.rms (held-out frames). FEM: the same ratio of the held-out rms
+  /// of the whitened residuals (positions / position noise and forces / force noise together),
+  /// which is the position ratio without a measured force and the force_rms ratio without
+  /// compared positions.
+  double improvement = 0;
   std::vector<Candidate> candidates;  ///< best first
 };
 
@@ -67,6 +79,11 @@ struct DiagnosisEvidence {
   /// Named signature statistics from the locate step (e.g. "persistence_after_unload": 0.8),
   /// shown in the report's evidence table.
   std::map<std::string, double> signatures;
+  /// FEM with a measured wrench: the force per frame [frame * 3 + axis] (N), NaN where not
+  /// compared; empty otherwise.
+  std::vector<double> force_observed;
+  std::vector<double> force_baseline;
+  std::vector<double> force_augmented;
 };
 
 }  // namespace pliant::host
