@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The main job: install what is missing, build, and estimate msm_beta on every bundled example.
+# The main job: install what is missing, build, estimate msm_beta on every bundled example, and
+# refine Young's modulus with the FEM on the three real silicone compression tests.
 # Usage: bash tools/demo.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -11,4 +12,9 @@ for recording in examples/*/; do
   [ -f "${recording}recording.json" ] || continue
   echo
   build/bin/pliant estimate "${recording%/}" --json "build/$(basename "$recording").estimate.json"
+done
+for recording in examples/phantom_compression/*/; do
+  [ -f "${recording}recording.json" ] || continue
+  echo
+  build/bin/pliant refine "${recording%/}" --json "build/$(basename "$recording").material.json"
 done

@@ -7,6 +7,7 @@
 #include "command_diagnose.hpp"
 #include "command_estimate.hpp"
 #include "command_import.hpp"
+#include "command_refine.hpp"
 #include "command_simulate.hpp"
 #include "exit_status.hpp"
 
@@ -40,6 +41,7 @@ int run(int argc, char** argv) {
   SimulateCommand simulate(app);
   DiagnoseCommand diagnose(app);
   ImportCommand importer(app);
+  RefineCommand refine(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& done) {  // --help, --version
@@ -51,6 +53,7 @@ int run(int argc, char** argv) {
   if (simulate.selected()) return run_reporting_errors("pliant simulate", [&] { return simulate.run(); });
   if (diagnose.selected()) return run_reporting_errors("pliant diagnose", [&] { return diagnose.run(); });
   if (importer.selected()) return run_reporting_errors("pliant import compression", [&] { return importer.run(); });
+  if (refine.selected()) return run_reporting_errors("pliant refine", [&] { return refine.run(); });
   std::cerr << app.help();
   return exit_usage;
 }

@@ -95,6 +95,54 @@ TEST_P(DecayFromFarStart, ConvergesToTruth) {
 
 INSTANTIATE_TEST_SUITE_P(Starts, DecayFromFarStart, ::testing::Values(0.1, 10.0));
 
+// Forward differences (n + 1 evaluations per Jacobian instead of 2n + 1) end at the same solution
+// from the same start; a parameter starting next to its upper bound falls back to the backward side.
+TEST(LeastSquaresFit, ForwardDifferencesReachTheSameSolutionWithFewerEvaluations) {
+  const double a = 3.0, tau = 0.7;
+  std::mt19937 rng(5);
+  std::normal_distribution<double> noise(0.0, 1e-3);
+  std::vector<double> t, y;
+  for (int i = 0; i < 80; ++i) {
+    t.push_back(0.05 * static_cast<double>(i));
+    y.push_back(a * std::exp(-t.back() / tau) + noise(rng));
+  }
+  const size_t n = t.size();
+  const auto residuals = [&](const std::vector<double>& v, std::vector<double>& r) {
+    for (size_t i = 0; i < n; ++i) r[i] = v[0] * std::exp(-t[i] / v[1]) - y[i];
+    return true;
+  };
+  const std::vector<FitParameter> parameters = {{"amplitude", 2.0, 1e-3, 1e3, true},
+                                                {"time_constant", 1.4, 1e-3, 1e3, true}};
+  FitOptions central;
+  central.loss = RobustLoss::none;
+  FitOptions forward = central;
+  forward.central_differences = false;
+  const auto c = fit_least_squares(parameters, static_cast<int>(n), residuals, central);
+  const auto f = fit_least_squares(parameters, static_cast<int>(n), residuals, forward);
+  // The same minimum (to the fit's tolerances), within a few standard deviations of the truth.
+  EXPECT_NEAR(f.values[0], c.values[0], 1e-6 * a);
+  EXPECT_NEAR(f.values[1], c.values[1], 1e-6 * tau);
+  EXPECT_NEAR(f.values[1], tau, 4 * c.standard_deviations[1]);
+  EXPECT_TRUE(f.converged);
+  // Per Jacobian 3 evaluations instead of 5. (Near the solution the O(step) error of forward
+  // differences slows Gauss-Newton's final convergence to very tight tolerances, so the totals
+  // are compared per iteration.)
+  EXPECT_LT(static_cast<double>(f.evaluations) / f.iterations, 0.8 * c.evaluations / c.iterations);
+  EXPECT_NEAR(f.standard_deviations[1], c.standard_deviations[1], 1e-2 * c.standard_deviations[1] + 1e-12);
+
+  // The time constant's upper bound just below the solution: the fit ends on the bound, where
+  // there is no room for a plus step, and its Jacobian there (for the covariance too) takes the
+  // minus side.
+  std::vector<FitParameter> tight = parameters;
+  tight[1] = {"time_constant", 0.9 * c.values[1], 1e-3, (1.0 - 1e-3) * c.values[1], true};
+  const auto b = fit_least_squares(tight, static_cast<int>(n), residuals, forward);
+  EXPECT_TRUE(b.at_bound[1]);
+  EXPECT_FALSE(b.at_bound[0]);
+  EXPECT_NEAR(b.values[1], tight[1].upper, 1e-6 * tau);
+  EXPECT_NEAR(b.values[0], c.values[0], 4 * c.standard_deviations[0]);
+  EXPECT_TRUE(std::isfinite(b.standard_deviations[0]));
+}
+
 TEST(LeastSquaresFit, HuberIgnoresOutliersThatBiasPlainLeastSquares) {
   Line line = noisy_line(2.0, 0.5, 0.02, 60, 11);
   for (size_t i = 40; i < 60; i += 4) line.y[i] += 3.0;  // five gross outliers at the high end

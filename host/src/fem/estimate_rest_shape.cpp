@@ -474,6 +474,7 @@ class RestShapeSolver {
     }
     result.forward_check_error_m = worst;
     result.forward_check_mean_error_m = sum / n;
+    result.forward_position_m = forward_.position_m;
   }
 
   FemModel model_;

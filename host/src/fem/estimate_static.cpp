@@ -473,6 +473,11 @@ void fill_position_rows(const FemRecordingProblem& problem, const FramePool& poo
   }
 }
 
+// The solutions at the estimate, for YoungsModulusOptions::keep_frame_positions.
+void keep_positions(const FramePool& pool, std::vector<StaticFrameRow>& rows) {
+  for (std::size_t p = 0; p < pool.plans().size(); ++p) rows[p].position_m = pool.cache()[p].position;
+}
+
 void check_modulus_options(const YoungsModulusOptions& options, double initial) {
   if (!(options.lower_youngs_modulus_pa > 0 && options.lower_youngs_modulus_pa < initial &&
         initial < options.upper_youngs_modulus_pa && std::isfinite(options.upper_youngs_modulus_pa))) {
@@ -638,6 +643,7 @@ YoungsModulusEstimate estimate_youngs_modulus_from_force(const FemRecordingProbl
   }
   e.position_rms_m = rms(coordinates) * std::sqrt(3.0);
   e.position_noise_m = options.position_noise_m > 0 ? options.position_noise_m : robust_scatter(coordinates);
+  if (options.keep_frame_positions) keep_positions(pool, e.frames);
   finish_estimate(e, options, fit, solved, "force-driven fit", timer);
   return e;
 }
@@ -869,6 +875,7 @@ YoungsModulusEstimate estimate_youngs_modulus_from_reaction(const FemRecordingPr
   e.position_rms_m = rms(coordinates) * std::sqrt(3.0);
   e.position_noise_m = position_count > 0 ? position_noise
                                           : (options.position_noise_m > 0 ? options.position_noise_m : robust_scatter(coordinates));
+  if (options.keep_frame_positions) keep_positions(pool, e.frames);
   finish_estimate(e, options, fit, solved,
                   options.fit_force_offset ? "reaction fit (with force offset)" : "reaction fit", timer);
   return e;

@@ -362,6 +362,10 @@ FemStepReport FemSolver::step(FemState& state, double dt_s, const Eigen::Ref<con
     im.target = im.previous_driven + fraction * (driven_position_m - im.previous_driven);
     im.start = state.position_m;
     im.x = state.position_m;
+    if (options.extrapolated_newton_start && state.last_substep_s > 0 && state.last_increment_m.size() == im.x.size() &&
+        state.last_increment_m.allFinite()) {
+      im.x += (h / state.last_substep_s) * state.last_increment_m;
+    }
     im.place_constrained(im.x, im.target, fixed_, driven_);
     for (int it = 0; it < options.newton_iterations; ++it) {
       // Damping acts on w = c_f v+ (as a function of x+); driven nodes with the secant velocity.
@@ -419,6 +423,8 @@ FemStepReport FemSolver::step(FemState& state, double dt_s, const Eigen::Ref<con
         state.velocity_m_s[i] = v_new;
       }
     }
+    state.last_increment_m = im.x - im.start;
+    state.last_substep_s = h;
     state.position_m = im.x;
     state.time_s += h;
     state.acceleration_valid = true;

@@ -52,8 +52,9 @@ class ModelEvaluator {
     return std::all_of(residuals.begin(), residuals.end(), [](double r) { return std::isfinite(r); });
   }
 
-  // Central differences in internal coordinates, one-sided at a bound. Row-major m x n.
-  bool jacobian(const double* internal, const std::vector<double>& at, double difference_step,
+  // Central differences in internal coordinates, one-sided at a bound (forward differences when
+  // !central: the plus side only, the minus side where there is no plus). Row-major m x n.
+  bool jacobian(const double* internal, const std::vector<double>& at, double difference_step, bool central,
                 double* out) const {
     const int n = static_cast<int>(coordinates_.parameters->size());
     std::vector<double> shifted(internal, internal + n);
@@ -65,7 +66,7 @@ class ModelEvaluator {
       shifted[static_cast<size_t>(j)] = hi;
       const bool has_plus = hi > internal[j] && evaluate(shifted.data(), plus);
       shifted[static_cast<size_t>(j)] = lo;
-      const bool has_minus = lo < internal[j] && evaluate(shifted.data(), minus);
+      const bool has_minus = (central || !has_plus) && lo < internal[j] && evaluate(shifted.data(), minus);
       shifted[static_cast<size_t>(j)] = internal[j];
       for (int i = 0; i < residual_count_; ++i) {
         const size_t ii = static_cast<size_t>(i);
@@ -128,8 +129,8 @@ double robust_rho(RobustLoss loss, double scale, double s) {
 class ModelCost final : public ceres::CostFunction {
  public:
   ModelCost(const ModelEvaluator& model, int parameter_count, int residual_count,
-            double difference_step)
-      : model_(model), parameter_count_(parameter_count), difference_step_(difference_step) {
+            double difference_step, bool central)
+      : model_(model), parameter_count_(parameter_count), difference_step_(difference_step), central_(central) {
     mutable_parameter_block_sizes()->push_back(parameter_count);
     set_num_residuals(residual_count);
   }
@@ -143,7 +144,7 @@ class ModelCost final : public ceres::CostFunction {
                 double** jacobians) const override {
     if (!model_.evaluate(parameters[0], at_)) return false;
     const bool want_jacobian = jacobians != nullptr && jacobians[0] != nullptr;
-    if (want_jacobian && !model_.jacobian(parameters[0], at_, difference_step_, jacobians[0])) {
+    if (want_jacobian && !model_.jacobian(parameters[0], at_, difference_step_, central_, jacobians[0])) {
       return false;
     }
     const size_t n = static_cast<size_t>(parameter_count_);
@@ -168,6 +169,7 @@ class ModelCost final : public ceres::CostFunction {
   const ModelEvaluator& model_;
   int parameter_count_;
   double difference_step_;
+  bool central_;
   RobustLoss loss_ = RobustLoss::none;
   double scale_ = 1.0;
   mutable std::vector<double> at_;
@@ -265,7 +267,7 @@ FitResult fit_least_squares(const std::vector<FitParameter>& parameters, int res
   const int n = static_cast<int>(parameters.size());
   const Coordinates coords{&parameters};
   ModelEvaluator model(coords, residual_count, residuals);
-  ModelCost cost(model, n, residual_count, options.difference_step);
+  ModelCost cost(model, n, residual_count, options.difference_step, options.central_differences);
 
   std::vector<double> internal(static_cast<size_t>(n));
   for (int j = 0; j < n; ++j) {
@@ -316,7 +318,8 @@ FitResult fit_least_squares(const std::vector<FitParameter>& parameters, int res
   const int m = residual_count;
   Eigen::MatrixXd jacobian(m, n);
   std::vector<double> row_major(static_cast<size_t>(m) * static_cast<size_t>(n));
-  const bool have_jacobian = model.jacobian(internal.data(), r, options.difference_step, row_major.data());
+  const bool have_jacobian = model.jacobian(internal.data(), r, options.difference_step, options.central_differences,
+                                                 row_major.data());
   for (int i = 0; i < m; ++i) {
     for (int j = 0; j < n; ++j) jacobian(i, j) = row_major[static_cast<size_t>(i * n + j)];
   }

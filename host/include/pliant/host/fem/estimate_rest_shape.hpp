@@ -126,6 +126,9 @@ struct RestShapeResult {
   double forward_check_error_m = 0;
   double forward_check_mean_error_m = 0;
   bool forward_check_converged = false;
+  /// The forward check's static solution (3n, m): what a simulation from the estimated rest shape
+  /// settles into, to compare with x_s node by node. Empty when the check did not run or failed.
+  Eigen::VectorXd forward_position_m;
   std::string message;          ///< one line: how the iteration ended
 };
 

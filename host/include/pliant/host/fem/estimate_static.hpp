@@ -128,6 +128,9 @@ struct YoungsModulusOptions {
   /// Threads that solve frames in parallel (each with its own model copy and solvers), >= 1. The
   /// result depends on it only through warm starts, at the static solves' tolerance (~1e-8).
   int threads = 1;
+  /// Keep every used frame's static solution at the estimate in StaticFrameRow::position_m
+  /// (3n doubles per used frame).
+  bool keep_frame_positions = false;
 };
 
 /// One row per used frame, at the solution.
@@ -144,6 +147,10 @@ struct StaticFrameRow {
   int position_count = 0;        ///< tracked free nodes compared in this frame
   double position_rms_m = std::numeric_limits<double>::quiet_NaN();  ///< rms |sim - tracked| (3D)
   int newton_iterations = 0;     ///< of the static solve that produced this solution
+  /// The static solution itself (3n node positions, m), only with
+  /// YoungsModulusOptions::keep_frame_positions (empty otherwise): for residual maps and
+  /// visualisation of the fitted model.
+  Eigen::VectorXd position_m;
 };
 
 struct YoungsModulusEstimate {

@@ -55,6 +55,11 @@ struct FitOptions {
   /// relative step), as a fraction of (upper - lower) for linear ones. Residual functions that
   /// solve iteratively must converge well below this step's effect.
   double difference_step = 1e-4;
+  /// Central differences (true, default: 2n + 1 evaluations per Jacobian, error O(step^2)) or
+  /// forward differences (false: n + 1, error O(step); backward at an upper bound). Forward
+  /// halves the cost of each Jacobian for models where one evaluation is a long simulation; the
+  /// O(step) error only perturbs the step direction and the covariance, not where the fit ends.
+  bool central_differences = true;
   /// Called after every iteration with (pass, iteration, cost); may be empty.
   std::function<void(int, int, double)> on_iteration;
 };
