@@ -47,6 +47,7 @@
 #include "pliant/core/msm_model.hpp"
 #include "pliant/core/observations.hpp"
 #include "pliant/core/online_deformability.hpp"
+#include "pliant/core/tracker.hpp"
 
 namespace pliant {
 namespace {
@@ -653,6 +654,61 @@ TYPED_TEST(RealTimeAllocation, OnlineDeformability) {
   EXPECT_EQ(estimate.frames, static_cast<std::uint32_t>(Scene<Dim, Scalar>::kFrames - 1));
   const double truth_beta = Scene<Dim, Scalar>::kTruthBeta;
   EXPECT_NEAR(estimate.msm_beta, truth_beta, 0.1);
+}
+
+// The tracker: every frame of the scene with a third of the particles occluded and a few
+// gross outliers, a frame without observations, a refused frame and a reset.
+TYPED_TEST(RealTimeAllocation, Tracker) {
+  using Scalar = typename TestFixture::FixtureScalar;
+  using Vec = typename TestFixture::FixtureVec;
+  constexpr int Dim = TestFixture::kFixtureDim;
+  const auto& scene = this->scene_;
+  TrackerConfig config;
+  std::vector<unsigned char> block(tracker_workspace_size(scene.model, config));
+  Arena arena(block.data(), block.size());
+  Tracker<Dim, Scalar> tracker;
+  MsmParams<Dim, Scalar> params;
+  params.msm_beta = Scalar(0.5);
+  ASSERT_EQ(tracker_init(arena, scene.model, params, config, tracker), Status::ok);
+  // Observations prepared outside the measured region.
+  const int frames = Scene<Dim, Scalar>::kFrames;
+  std::vector<Vec> observed(static_cast<std::size_t>(frames * scene.n));
+  for (int k = 0; k < frames; ++k) {
+    for (int i = 0; i < scene.n; ++i) {
+      Vec o = scene.frame(k)[i];
+      if ((i + k / 10) % 3 == 0) o.setConstant(std::numeric_limits<Scalar>::quiet_NaN());
+      if ((i * 7 + k) % 23 == 0) o(0) += Scalar(50) * scene.model.spacing;
+      observed[static_cast<std::size_t>(k * scene.n + i)] = o;
+    }
+  }
+  const Scalar dt = Scalar(1) / Scalar(30);
+  TrackerFrame<Dim, Scalar> frame;
+  frame.dt = dt;
+  frame.driven.ids = &scene.tool;
+  frame.driven.count = 1;
+  std::vector<Status> statuses(static_cast<std::size_t>(frames), Status::not_initialized);
+  Status empty = Status::ok, rejected = Status::ok;
+  AllocationCounts counts;
+  {
+    AllocationCounter counter;
+    tracker_reset(scene.model, tracker);
+    for (int k = 1; k < frames; ++k) {
+      frame.driven.positions = &scene.tool_targets[static_cast<std::size_t>(k)];
+      frame.observed = observed.data() + static_cast<std::ptrdiff_t>(k) * scene.n;
+      statuses[static_cast<std::size_t>(k)] = tracker_update(scene.model, tracker, frame);
+    }
+    frame.observed = nullptr;
+    empty = tracker_update(scene.model, tracker, frame);
+    frame.dt = std::numeric_limits<Scalar>::quiet_NaN();
+    rejected = tracker_update(scene.model, tracker, frame);
+    counts = counter.stop();
+  }
+  EXPECT_NO_HEAP(counts, "tracker reset/update");
+  for (int k = 1; k < frames; ++k) EXPECT_EQ(statuses[static_cast<std::size_t>(k)], Status::ok) << k;
+  EXPECT_EQ(empty, Status::no_observations);
+  EXPECT_EQ(rejected, Status::invalid_argument);
+  EXPECT_GT(tracker.counters.outliers, 0u);
+  EXPECT_TRUE(this->state_finite(tracker.state));
 }
 
 TYPED_TEST(RealTimeAllocation, EstimateTrajectory) {
