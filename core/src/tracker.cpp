@@ -39,7 +39,7 @@ Status layout(Arena& arena, const MsmModel<Dim, Scalar>& model, Tracker<Dim, Sca
   tracker.status = arena.carve<TrackStatus>(n);
   tracker.unobserved_frames = arena.carve<std::int32_t>(n);
   using Vec = typename Tracker<Dim, Scalar>::Vec;
-  int largest_cluster = 0;
+  std::int32_t largest_cluster = 0;
   for (int c = 0; c < model.cluster_count; ++c) {
     largest_cluster = std::max(largest_cluster, model.cluster_begin[c + 1] - model.cluster_begin[c]);
   }
