@@ -7,9 +7,16 @@
 # The compression-test CSV fuzzer (tests/fuzz/compression_csv_fuzz.cpp) follows for
 # ${PLIANT_CSV_FUZZ_SECONDS:-30} seconds.
 #
+# The telemetry decoder fuzzer (tests/fuzz/telemetry_fuzz.cpp) follows for
+# ${PLIANT_TELEMETRY_FUZZ_SECONDS:-20} seconds.
+#
+# The HAL fault-script parser fuzzer (tests/fuzz/fault_script_fuzz.cpp) follows for
+# ${PLIANT_FAULT_FUZZ_SECONDS:-15} seconds.
+#
 # Environment: PLIANT_FUZZ_SECONDS (default 60), PLIANT_MESH_FUZZ_SECONDS (default 30),
-# PLIANT_CSV_FUZZ_SECONDS (default 30), PLIANT_FUZZ_BUILD_DIR (default build-fuzz),
-# CXX_FUZZ (default clang++).
+# PLIANT_CSV_FUZZ_SECONDS (default 30), PLIANT_TELEMETRY_FUZZ_SECONDS (default 20),
+# PLIANT_FUZZ_BUILD_DIR (default build-fuzz), CXX_FUZZ (default clang++), CC_FUZZ (default
+# clang: the telemetry codec is C).
 set -euo pipefail
 
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -19,11 +26,12 @@ seconds="${PLIANT_FUZZ_SECONDS:-60}"
 cmake -S "$root" -B "$build" \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_COMPILER="${CXX_FUZZ:-clang++}" \
+  -DCMAKE_C_COMPILER="${CC_FUZZ:-clang}" \
   -DPLIANT_BUILD_FUZZERS=ON \
   -DPLIANT_BUILD_TESTS=ON \
   -DPLIANT_BUILD_HOST=OFF \
   -DPLIANT_BUILD_BENCHMARKS=OFF
-cmake --build "$build" --target recording_fuzz mesh_fuzz compression_csv_fuzz -j "$(nproc)"
+cmake --build "$build" --target recording_fuzz mesh_fuzz compression_csv_fuzz telemetry_fuzz fault_script_fuzz -j "$(nproc)"
 
 fuzzer="$build/bin/recording_fuzz"
 [ -x "$fuzzer" ] || fuzzer="$(find "$build" -type f -name recording_fuzz -perm -u+x | head -n 1)"
@@ -123,4 +131,46 @@ printf '\357\273\277Sample: cyl-7;\r\nDiameter (mm): 50\r\nheight: 0.03 m\r\nSpe
   -timeout=10 \
   -rss_limit_mb=2048 \
   -artifact_prefix="$csv_artifacts/" \
+  -print_final_stats=1
+
+# Telemetry streaming decoder. Byte 0 of an input picks how the rest is split into pieces
+# (tests/fuzz/telemetry_fuzz.cpp). Seeds (made with the codec's encoder): every message type in
+# one piece; two 3D particle chunks after a short garbage frame, an unknown type and a version-2
+# packet, in 1..64-byte pieces; a counters message, a verdict with a flipped bit and a cut
+# estimate.
+telemetry_fuzzer="$build/bin/telemetry_fuzz"
+[ -x "$telemetry_fuzzer" ] || telemetry_fuzzer="$(find "$build" -type f -name telemetry_fuzz -perm -u+x | head -n 1)"
+telemetry_corpus="$build/fuzz/telemetry-corpus"
+telemetry_artifacts="$build/fuzz/telemetry-artifacts"
+mkdir -p "$telemetry_corpus" "$telemetry_artifacts"
+printf '\x00\x03\x01\x01\x01\x03\xe8\x03\x01\x01\x01\x01\x01\x01\x01\x01\x01\x01\x01\x03\xd8\x3f\x01\x01\x01\x01\x01\x0e\xb0\x3f\x61\x32\x55\x30\x2a\xa9\x23\x3f\x40\xe2\x01\x04\x03\x2f\xdb\x00\x04\x01\x02\x01\x03\xd0\x07\x01\x01\x01\x01\x01\x05\x01\x0e\x01\x04\x02\x50\x01\x02\x01\x01\x01\x05\x6f\x12\x83\x3b\x01\x07\xf0\x40\xcd\xcc\x4c\x3d\x01\x13\xe0\x40\x8f\xc2\x75\x3d\x42\x60\x65\x3b\xe7\xfb\x29\x3d\xcd\xcc\xdc\x40\x01\x03\x80\x3e\x01\x01\x04\x3f\xe2\xd9\x00\x04\x01\x03\x02\x03\xb8\x0b\x01\x01\x01\x01\x01\x01\x01\x01\x01\x02\x02\x02\x06\x01\x01\x02\x06\x01\x01\x01\x01\x05\x6f\x12\x83\x3a\x09\x0a\xd7\x23\x3c\x58\x39\x34\x3c\x09\x0a\xd7\xa3\x3c\x31\x08\xac\x3c\x12\x8f\xc2\xf5\x3c\xb6\xf3\xfd\x3c\x01\x0a\xd7\x23\x3d\x9d\xef\x27\x3d\x0c\xcc\xcc\x4c\x3d\x5f\xe5\x50\x3d\x02\xeb\xc4\x00\x04\x01\x04\x03\x03\xa0\x0f\x01\x01\x01\x01\x01\x02\x02\x02\x08\x03\xe8\x03\x01\x04\x92\x10\x07\x01\x01\x03\xc0\xe0\x00' > "$telemetry_corpus/seed-all-types"
+printf '\x07\x03\x41\x42\x00\x04\x01\x03\x04\x03\x88\x13\x01\x01\x01\x01\x01\x02\x01\x01\x01\x02\x03\x02\x0c\x01\x01\x02\x04\x0d\x6f\x12\x03\xba\x6f\x12\x03\x3a\xa6\x9b\xc4\x3a\x0d\xe3\xa5\x1b\x3c\x31\x08\x2c\x3c\x7f\x6a\x3c\x3c\x0d\x77\xbe\x9f\x3c\x9e\xef\xa7\x3c\xc5\x20\xb0\x3c\x10\xfc\xa9\xf1\x3c\x23\xdb\xf9\x3c\x24\x06\x01\x3d\x01\x3d\x9c\x00\x04\x01\x03\x05\x03\x88\x13\x01\x01\x01\x01\x01\x02\x01\x01\x01\x02\x03\x02\x0c\x02\x04\x02\x04\x0d\xc0\xca\x21\x3d\x53\xe3\x25\x3d\xe7\xfb\x29\x3d\x1a\x82\xc0\x4a\x3d\x15\xd9\x4e\x3d\xa9\xf1\x52\x3d\x02\x45\xb6\x73\x3d\xd8\xce\x77\x3d\x6c\xe7\x7b\x3d\x0d\x04\x56\x8e\x3d\x4e\x62\x90\x3d\x97\x6e\x92\x3d\x03\x44\x4d\x00\x04\x01\x03\x06\x03\x88\x13\x01\x01\x01\x01\x01\x02\x01\x01\x01\x02\x03\x02\x0c\x02\x08\x02\x04\x0d\xe5\xd0\xa2\x3d\x2f\xdd\xa4\x3d\x78\xe9\xa6\x3d\x0d\xc6\x4b\xb7\x3d\x10\x58\xb9\x3d\x59\x64\xbb\x3d\x1a\xa7\xc6\xcb\x3d\xf1\xd2\xcd\x3d\x3a\xdf\xcf\x3d\x01\x89\x41\xe0\x3d\xd3\x4d\xe2\x3d\x1c\x5a\xe4\x3d\x03\xbe\xfe\x00\x04\x01\x09\x28\x03\xe8\x03\x01\x01\x01\x01\x01\x06\x01\x02\x03\x72\x43\x00\x04\x02\x01\x29\x03\xe8\x03\x01\x01\x01\x01\x01\x20\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\xf2\x4e\x00' > "$telemetry_corpus/seed-chunks-garbage"
+printf '\x01\x04\x01\x04\x07\x03\x70\x17\x01\x01\x01\x01\x01\x02\x03\x02\x01\x02\x01\x01\x01\x02\x02\x02\x02\x01\x01\x02\x03\x02\x03\x01\x01\x03\x71\x27\x00\x04\x01\x02\x08\x03\x58\x1b\x01\x01\x01\x01\x01\x05\x01\x0e\x01\x04\x02\x50\x01\x01\x01\x01\x01\x05\x6f\x12\x83\x3b\x01\x07\xf0\x40\xcd\xcc\x4c\x3d\x01\x13\xe0\x40\x8f\xc2\x75\x3d\x42\x60\x65\x3b\xe7\xfb\x29\x3d\xcd\xcc\xdc\x40\x01\x03\x80\x3e\x01\x01\x04\x3f\x7d\xd1\x00\x04\x01\x01\x09\x03\x40\x1f\x01\x01\x01\x01\x01\x01\x01\x01\x01\x01\x01\x03\xd8\x3f\x01\x01\x01\x01\x01\x0e\xb0\x3f\x61\x32\x55\x30\x2a\xa9\x23\x3f\x40' > "$telemetry_corpus/seed-damaged"
+
+"$telemetry_fuzzer" "$telemetry_corpus" \
+  -dict="$root/tests/fuzz/telemetry_fuzz.dict" \
+  -max_total_time="${PLIANT_TELEMETRY_FUZZ_SECONDS:-20}" \
+  -max_len=8192 \
+  -timeout=10 \
+  -rss_limit_mb=2048 \
+  -artifact_prefix="$telemetry_artifacts/" \
+  -print_final_stats=1
+
+# HAL fault scripts (one event per line: t_s kind device duration_s [value]). Seeds: every kind
+# on a device that has it, comments, CRLF, hex fault bits; and a malformed script.
+fault_fuzzer="$build/bin/fault_script_fuzz"
+[ -x "$fault_fuzzer" ] || fault_fuzzer="$(find "$build" -type f -name fault_script_fuzz -perm -u+x | head -n 1)"
+fault_corpus="$build/fuzz/fault-script-corpus"
+fault_artifacts="$build/fuzz/fault-script-artifacts"
+mkdir -p "$fault_corpus" "$fault_artifacts"
+printf '# faults\n1.2 timeout gripper 0.05\r\n1.5\tbus_off ft 0.02 # CAN\n2 fault_bits gripper 0.1 0x0e00\n2.5 fault_bits ft 0.1 32\n3 stamp_jump observer 0.2 -0.25\n3.5 occlude observer 1e-1 0.5\n4 nan depth 0.1\n4 drop color 0.1\n5 freeze_data observer 0.1\n5 freeze_stamp ft 0.1\n6 disconnect gripper 1\n' \
+  > "$fault_corpus/seed-kinds"
+printf '1 drop gripper\nx nan ft 1\n1 bus_off gripper 1\n1 occlude observer 0.1 2\n' > "$fault_corpus/seed-malformed"
+
+"$fault_fuzzer" "$fault_corpus" \
+  -max_total_time="${PLIANT_FAULT_FUZZ_SECONDS:-15}" \
+  -max_len=4096 \
+  -timeout=10 \
+  -rss_limit_mb=2048 \
+  -artifact_prefix="$fault_artifacts/" \
   -print_final_stats=1

@@ -15,6 +15,9 @@ packages=(
   libbenchmark-dev               # bench/
   clang libclang-rt-14-dev       # libFuzzer targets and their sanitizer runtimes
   chromium                       # headless browser for the report rendering test
+  g++-aarch64-linux-gnu qemu-user  # cross build for aarch64 Linux, its tests run under qemu-aarch64
+  googletest file                # GoogleTest sources, compiled for aarch64; `file` checks the binaries
+  gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib  # Cortex-M firmware
 )
 
 missing=()

@@ -9,6 +9,7 @@
 #include "command_import.hpp"
 #include "command_refine.hpp"
 #include "command_simulate.hpp"
+#include "command_telemetry.hpp"
 #include "exit_status.hpp"
 
 namespace pliant::cli {
@@ -42,6 +43,7 @@ int run(int argc, char** argv) {
   DiagnoseCommand diagnose(app);
   ImportCommand importer(app);
   RefineCommand refine(app);
+  TelemetryCommand telemetry(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& done) {  // --help, --version
@@ -54,6 +56,7 @@ int run(int argc, char** argv) {
   if (diagnose.selected()) return run_reporting_errors("pliant diagnose", [&] { return diagnose.run(); });
   if (importer.selected()) return run_reporting_errors("pliant import compression", [&] { return importer.run(); });
   if (refine.selected()) return run_reporting_errors("pliant refine", [&] { return refine.run(); });
+  if (telemetry.selected()) return run_reporting_errors("pliant telemetry", [&] { return telemetry.run(); });
   std::cerr << app.help();
   return exit_usage;
 }
