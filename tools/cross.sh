@@ -21,8 +21,6 @@ if command -v ccache > /dev/null; then
   export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$root}
 fi
 
-targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(aarch64 cortex-m7)
 
 aarch64() {
   local build=${prefix}aarch64
@@ -128,7 +126,19 @@ cortex_m7() {
     "${workspace:-0}"
 }
 
-for target in "${targets[@]}"; do
+if [ $# -eq 0 ]; then
+  # Both, each in its own shell so that one failing still lets the other run and report.
+  failed=()
+  for target in aarch64 cortex-m7; do
+    bash "$root/tools/cross.sh" "$target" || failed+=("$target")
+  done
+  if [ ${#failed[@]} -gt 0 ]; then
+    echo "cross builds failed: ${failed[*]}" >&2
+    exit 1
+  fi
+  exit 0
+fi
+for target in "$@"; do
   case $target in
     aarch64) aarch64 ;;
     cortex-m7) cortex_m7 ;;
