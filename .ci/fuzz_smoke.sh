@@ -174,3 +174,14 @@ printf '1 drop gripper\nx nan ft 1\n1 bus_off gripper 1\n1 occlude observer 0.1 
   -rss_limit_mb=2048 \
   -artifact_prefix="$fault_artifacts/" \
   -print_final_stats=1
+
+# Driver decoder fuzzers: each .ci/fuzz.d/<driver>.sh builds its targets in "$build" (when the
+# driver's library is installed, i.e. tests/fuzz/drivers/<driver>.cmake defined them) and runs them
+# from seeds it writes, with the same failure rules. They see $root, $build and this shell's
+# options (set -euo pipefail).
+shopt -s nullglob
+for fragment in "$root"/.ci/fuzz.d/*.sh; do
+  echo "== fuzz smoke: $(basename "$fragment")"
+  # shellcheck source=/dev/null
+  source "$fragment"
+done

@@ -15,6 +15,12 @@ packages=(
   libbenchmark-dev               # bench/
   clang libclang-rt-14-dev       # libFuzzer targets and their sanitizer runtimes
   chromium                       # headless browser for the report rendering test
+  libopencv-dev                  # vision front end (dense optical flow) and the opencv driver
+  libnanoflann-dev               # kd-tree for the depth tracker's correspondences
+  libmodbus-dev                  # modbus driver: Robotiq grippers and FT 300, and its test emulator
+  libusb-1.0-0-dev               # usb driver: device discovery and hotplug
+  libopenni2-dev                 # openni2 driver: depth cameras and .oni playback
+  libcamera-dev                  # libcamera driver: cameras on embedded Linux
   g++-aarch64-linux-gnu qemu-user  # cross build for aarch64 Linux, its tests run under qemu-aarch64
   googletest file                # GoogleTest sources, compiled for aarch64; `file` checks the binaries
   gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib  # Cortex-M firmware

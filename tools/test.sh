@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Every test: install what is missing, build, run the unit, integration, acceptance and install
 # tests, then all but the slow acceptance runs (ctest label) under AddressSanitizer +
-# UndefinedBehaviorSanitizer, then a short libFuzzer smoke run of every parser.
-# The cross builds (tools/cross.sh: aarch64 tests under qemu, the Cortex-M7 firmware with its
-# no-allocator check) are not part of this run yet: three tests still fail under qemu.
+# UndefinedBehaviorSanitizer, then the cross builds (tools/cross.sh: the aarch64 tests under qemu,
+# the Cortex-M7 firmware with its no-allocator check), then a short libFuzzer smoke run of every
+# parser and decoder.
 # Usage: bash tools/test.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -20,6 +20,9 @@ cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPLIANT_SANITIZE=ON 
 cmake --build build-asan -j"$jobs"
 ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
   ctest --test-dir build-asan -j"$jobs" --output-on-failure -LE acceptance -E install_consumer
+
+echo "== cross builds: aarch64 under qemu, Cortex-M7 firmware"
+bash tools/cross.sh
 
 echo "== libFuzzer smoke run"
 bash .ci/fuzz_smoke.sh
