@@ -2,7 +2,7 @@
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
-set(PLIANT_INSTALL_TARGETS pliant_core pliant_bridge)
+set(PLIANT_INSTALL_TARGETS pliant_core pliant_bridge pliant_hal)
 if(PLIANT_BUILD_HOST)
   list(APPEND PLIANT_INSTALL_TARGETS pliant_host pliant)
 endif()
@@ -11,6 +11,7 @@ install(TARGETS ${PLIANT_INSTALL_TARGETS} EXPORT pliantTargets
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
   RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 install(DIRECTORY core/include/pliant DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(DIRECTORY hal/include/pliant DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(DIRECTORY firmware-bridge/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} FILES_MATCHING PATTERN "*.h")
 if(PLIANT_BUILD_HOST)
   install(DIRECTORY host/include/pliant DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})

@@ -8,8 +8,10 @@
 #include "command_estimate.hpp"
 #include "command_import.hpp"
 #include "command_refine.hpp"
+#include "command_replay.hpp"
 #include "command_simulate.hpp"
 #include "command_telemetry.hpp"
+#include "command_track.hpp"
 #include "exit_status.hpp"
 
 namespace pliant::cli {
@@ -44,6 +46,8 @@ int run(int argc, char** argv) {
   ImportCommand importer(app);
   RefineCommand refine(app);
   TelemetryCommand telemetry(app);
+  TrackCommand track(app);
+  ReplayCommand replay(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& done) {  // --help, --version
@@ -57,6 +61,8 @@ int run(int argc, char** argv) {
   if (importer.selected()) return run_reporting_errors("pliant import compression", [&] { return importer.run(); });
   if (refine.selected()) return run_reporting_errors("pliant refine", [&] { return refine.run(); });
   if (telemetry.selected()) return run_reporting_errors("pliant telemetry", [&] { return telemetry.run(); });
+  if (track.selected()) return run_reporting_errors("pliant track", [&] { return track.run(); });
+  if (replay.selected()) return run_reporting_errors("pliant replay", [&] { return replay.run(); });
   std::cerr << app.help();
   return exit_usage;
 }

@@ -11,6 +11,7 @@
 #include "pliant/hal/guard_inputs.hpp"
 #include "pliant/hal/mock/fault_script.hpp"
 #include "pliant/hal/mock/mock_cameras.hpp"
+#include "pliant/hal/mock/replay_devices.hpp"
 #include "pliant/hal/stream_monitor.hpp"
 
 namespace pliant::hal {
@@ -79,6 +80,57 @@ TEST(HalAllocation, DeviceCyclesAllocateNothing) {
   EXPECT_GT(delivered, 40);
   EXPECT_GT(plant.counters().msm_steps, 1000u);
   EXPECT_GT(gripper.fault_counters().total() + ft.fault_counters().total() + observer.fault_counters().total(), 0u);
+}
+
+TEST(HalAllocation, ReplayReadsAllocateNothing) {
+  RecordedChannel wrench, gripper, particles;
+  wrench.width = 6;
+  gripper.width = 2;
+  particles.width = 3 * 20;
+  for (int k = 0; k < 200; ++k) {
+    const double t = 0.01 * k;
+    wrench.t_s.push_back(t);
+    gripper.t_s.push_back(t);
+    particles.t_s.push_back(t);
+    for (int a = 0; a < 6; ++a) wrench.values.push_back(a + t);
+    gripper.values.push_back(0.05 - 1e-4 * k);
+    gripper.values.push_back(0.1 * k);
+    for (int a = 0; a < particles.width; ++a) particles.values.push_back(0.001 * a + t);
+  }
+  test::SteppedClock t;
+  ReplayForceTorque ft(wrench, t.clock);
+  ReplayGripper g(gripper, t.clock);
+  ReplayParticleObserver o(particles, 3, t.clock);
+  const std::string script = "1.2 nan ft 0.1\n1.3 occlude observer 0.2\n1.4 freeze_stamp gripper 0.1\n1.6 timeout ft 0.05\n";
+  FaultScript faults;
+  FaultScriptError error;
+  ASSERT_EQ(parse_fault_script(script.data(), script.size(), faults, error), HalStatus::ok);
+  ASSERT_EQ(ft.set_fault_schedule(faults.of(FaultDevice::force_torque)), HalStatus::ok);
+  ASSERT_EQ(g.set_fault_schedule(faults.of(FaultDevice::gripper)), HalStatus::ok);
+  ASSERT_EQ(o.set_fault_schedule(faults.of(FaultDevice::observer)), HalStatus::ok);
+  for (Device* d : {static_cast<Device*>(&ft), static_cast<Device*>(&g), static_cast<Device*>(&o)}) {
+    ASSERT_EQ(d->configure(), HalStatus::ok);
+    ASSERT_EQ(d->start(), HalStatus::ok);
+  }
+  WrenchReading w;
+  GripperReading gr;
+  ParticleFrame p;
+  long delivered = 0;
+  AllocationCounts counts;
+  {
+    AllocationCounter counter;
+    for (int k = 0; k < 2500; ++k) {
+      t.step();
+      delivered += ft.read(w) == HalStatus::ok ? 1 : 0;
+      delivered += g.read(gr) == HalStatus::ok ? 1 : 0;
+      delivered += o.read(p) == HalStatus::ok ? 1 : 0;
+      (void)g.freeze();
+    }
+    counts = counter.stop();
+  }
+  EXPECT_EQ(counts.total(), 0u) << "news=" << counts.news << " mallocs=" << counts.mallocs;
+  EXPECT_GT(delivered, 500);
+  EXPECT_TRUE(ft.finished() && g.finished() && o.finished());
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <initializer_list>
 
 namespace pliant::hal {
 namespace {
@@ -64,6 +65,18 @@ ActiveFaults FaultSchedule::active_at(double t_s) const noexcept {
     active.value[static_cast<int>(e.kind)] = e.value;
   }
   return active;
+}
+
+HalStatus apply_read_fault(const FaultSchedule& schedule, double now_s, FaultCounters& counters) noexcept {
+  const ActiveFaults active = schedule.active_at(now_s);
+  for (const FaultKind kind : {FaultKind::disconnect, FaultKind::bus_off, FaultKind::timeout}) {
+    if (!active.has(kind)) continue;
+    ++counters.injected[static_cast<int>(kind)];
+    return kind == FaultKind::disconnect ? HalStatus::disconnected
+           : kind == FaultKind::bus_off  ? HalStatus::bus_off
+                                         : HalStatus::timeout;
+  }
+  return HalStatus::ok;
 }
 
 }  // namespace pliant::hal

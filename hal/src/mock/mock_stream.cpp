@@ -36,22 +36,7 @@ void MockStream::start(double t_start_s) noexcept {
   started_ = true;
 }
 
-HalStatus MockStream::read_fault(double now_s) noexcept {
-  const ActiveFaults active = schedule_.active_at(now_s);
-  if (active.has(FaultKind::disconnect)) {
-    count(FaultKind::disconnect);
-    return HalStatus::disconnected;
-  }
-  if (active.has(FaultKind::bus_off)) {
-    count(FaultKind::bus_off);
-    return HalStatus::bus_off;
-  }
-  if (active.has(FaultKind::timeout)) {
-    count(FaultKind::timeout);
-    return HalStatus::timeout;
-  }
-  return HalStatus::ok;
-}
+HalStatus MockStream::read_fault(double now_s) noexcept { return apply_read_fault(schedule_, now_s, counters_); }
 
 bool MockStream::take(double now_s, std::uint64_t& index, double& stamp_s, std::uint64_t& sequence) noexcept {
   if (!started_ || !std::isfinite(now_s)) return false;

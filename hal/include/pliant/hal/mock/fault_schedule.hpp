@@ -120,4 +120,8 @@ struct FaultCounters {
   }
 };
 
+/// The read fault `schedule` has active at now_s (disconnect, then bus_off, then timeout),
+/// counted in `counters`; ok when none. Shared by every mock's read path.
+HalStatus apply_read_fault(const FaultSchedule& schedule, double now_s, FaultCounters& counters) noexcept;
+
 }  // namespace pliant::hal
