@@ -179,8 +179,9 @@ void elastic_cluster_pass(const MsmModel<Dim, Scalar>& model, const MsmParams<Di
         const Scalar length2 = w * w + x * x + y * y + z * z;
         // extract_rotation's preliminaries: nothing to do for a finite, nonzero A_pq and a
         // unit warm start.
-        ok = (scale2 > Scalar(0)) & (scale2 <= std::numeric_limits<Scalar>::max()) &
-             (std::abs(length2 - Scalar(1)) <= Scalar(64) * kEpsilon);
+        // Branch-free on purpose (integer &, not &&).
+        ok = (static_cast<int>(scale2 > Scalar(0)) & static_cast<int>(scale2 <= std::numeric_limits<Scalar>::max()) &
+              static_cast<int>(std::abs(length2 - Scalar(1)) <= Scalar(64) * kEpsilon)) != 0;
         guard[lane] = std::sqrt(kEpsilon * scale2);
         detail::quaternion_to_matrix(w, x, y, z, r);
       } else {
