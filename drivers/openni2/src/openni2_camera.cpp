@@ -1,0 +1,495 @@
+#include "pliant/drivers/openni2/openni2_camera.hpp"
+
+#include <OpenNI.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <thread>
+#include <utility>
+
+#include "openni2_runtime.hpp"
+
+namespace pliant::drivers::openni2 {
+
+using hal::HalStatus;
+
+namespace {
+
+using SteadyTime = std::chrono::steady_clock::time_point;
+
+double seconds_since(SteadyTime then, SteadyTime now) noexcept {
+  return std::chrono::duration<double>(now - then).count();
+}
+
+bool in_range(double value, double low, double high) noexcept {
+  return std::isfinite(value) && value >= low && value <= high;
+}
+
+bool in_open_low(double value, double low, double high) noexcept {
+  return std::isfinite(value) && value > low && value <= high;
+}
+
+// Debian's DummyDevice answers these URIs (never enumerated).
+bool is_dummy_uri(const char* uri) noexcept {
+  return std::strcmp(uri, "Dummy") == 0 || std::strcmp(uri, "Oz") == 0 || std::strcmp(uri, "PingPong") == 0;
+}
+
+double depth_scale_of(openni::PixelFormat format) noexcept {
+  switch (format) {
+    case openni::PIXEL_FORMAT_DEPTH_1_MM: return 1e-3;
+    case openni::PIXEL_FORMAT_DEPTH_100_UM: return 1e-4;
+    default: return 0;
+  }
+}
+
+std::string extended_error() { return openni::OpenNI::getExtendedError(); }
+
+}  // namespace
+
+struct Openni2Camera::Impl {
+  openni::Device device;
+  openni::VideoStream stream;
+  openni::VideoFrameRef frame;
+  std::unique_ptr<detail::DeviceEvents> events;
+  bool device_open = false;
+  bool stream_created = false;
+  bool stream_running = false;
+  bool recording = false;
+  bool stepped = false;
+  bool dummy = false;                  // Debian's DummyDevice (see on_stop)
+  std::uint64_t received_at_start = 0;
+  openni::PixelFormat format = openni::PIXEL_FORMAT_DEPTH_1_MM;
+  double depth_scale_m = 1e-3;
+  int width = 0;
+  int height = 0;
+  DepthIntrinsics intrinsics;
+  std::vector<std::uint16_t> image;
+  std::uint32_t last_frame_number = 0;  // recordings: the depth node's last frame number
+  double stall_timeout_s = 0;
+  int step_timeout_ms = 0;
+
+  // Stream state.
+  Openni2CameraStats stats;
+  SteadyTime stopped_at{};
+  bool ever_stopped = false;
+  SteadyTime last_progress{};
+  // Stepped stamps.
+  bool have_anchor = false;
+  double anchor_s = 0;           // clock at the first start
+  double paused_s = 0;           // clock time spent stopped since
+  double clock_at_stop_s = 0;
+  bool have_first_ts = false;
+  std::uint64_t first_ts_us = 0;
+  // Live stamps.
+  bool have_offset = false;
+  double offset_s = 0;
+  // Sequence numbers.
+  bool have_index = false;
+  std::int64_t index_base = 0;   // sequence = index - index_base
+  std::uint64_t last_sequence = 0;
+
+  DepthIntrinsics no_intrinsics;
+
+  void stop_stream() noexcept {
+    if (!stream_running) return;
+    stream.stop();
+    stream_running = false;
+    stopped_at = std::chrono::steady_clock::now();
+    ever_stopped = true;
+  }
+
+  // Releases every OpenNI2 object, after the teardown grace (see the header).
+  void teardown(double grace_s) noexcept {
+    stop_stream();
+    frame.release();
+    if (stream_created && ever_stopped && grace_s > 0) {
+      const double waited = seconds_since(stopped_at, std::chrono::steady_clock::now());
+      if (waited < grace_s) std::this_thread::sleep_for(std::chrono::duration<double>(grace_s - waited));
+    }
+    if (events) events->detach();
+    if (stream_created) stream.destroy();
+    stream_created = false;
+    if (device_open) device.close();
+    device_open = false;
+    events.reset();
+  }
+};
+
+const char* intrinsics_source_name(IntrinsicsSource source) noexcept {
+  switch (source) {
+    case IntrinsicsSource::none: return "none";
+    case IntrinsicsSource::device_fov: return "device_fov";
+    case IntrinsicsSource::configured: return "configured";
+  }
+  return "unknown";
+}
+
+Openni2Camera::Openni2Camera(const hal::Clock& clock, Openni2CameraConfig config)
+    : clock_(clock), config_(std::move(config)) {}
+
+Openni2Camera::~Openni2Camera() {
+  if (impl_) impl_->teardown(config_.teardown_grace_s);
+}
+
+int Openni2Camera::width() const noexcept { return impl_ ? impl_->width : 0; }
+int Openni2Camera::height() const noexcept { return impl_ ? impl_->height : 0; }
+
+const DepthIntrinsics& Openni2Camera::intrinsics() const noexcept {
+  static const DepthIntrinsics none;
+  return impl_ ? impl_->intrinsics : none;
+}
+
+Openni2CameraStats Openni2Camera::stats() const noexcept { return impl_ ? impl_->stats : Openni2CameraStats{}; }
+
+bool Openni2Camera::end_of_stream() const noexcept { return impl_ && impl_->stats.end_of_stream; }
+
+HalStatus Openni2Camera::on_configure() {
+  last_error_.clear();
+  last_check_ = OniCheck::ok;
+  recording_info_ = OniFileInfo{};
+  const HalStatus status = configure_impl();
+  if (status != HalStatus::ok && impl_) {
+    impl_->teardown(0);  // nothing was started: no grace needed
+    impl_.reset();
+  }
+  return status;
+}
+
+HalStatus Openni2Camera::configure_impl() {
+  const Openni2CameraConfig& c = config_;
+  const auto invalid = [this](const std::string& why) {
+    last_error_ = "invalid configuration: " + why;
+    return HalStatus::invalid_argument;
+  };
+  if (c.location.empty()) return invalid("location is empty");
+  if (!in_open_low(c.playback_speed, 0, 16)) return invalid("playback_speed must be in (0, 16]");
+  if (c.width < 0 || c.width > kMaxDepthSide || c.height < 0 || c.height > kMaxDepthSide) {
+    return invalid("width and height must be in 0.." + std::to_string(kMaxDepthSide));
+  }
+  if (c.fps < 0 || c.fps > 1000) return invalid("fps must be in 0..1000");
+  if (!in_open_low(c.step_timeout_s, 0, 60)) return invalid("step_timeout_s must be in (0, 60]");
+  if (!in_open_low(c.stall_timeout_s, 0, 600)) return invalid("stall_timeout_s must be in (0, 600]");
+  if (!in_range(c.teardown_grace_s, 0, 5)) return invalid("teardown_grace_s must be in [0, 5]");
+  if (c.source == Openni2Source::device && c.playback == Openni2Playback::stepped) {
+    return invalid("stepped playback is for recordings only");
+  }
+  const DepthIntrinsics& fallback = c.fallback_intrinsics;
+  const bool has_fallback = !(std::isnan(fallback.fx) && std::isnan(fallback.fy) && std::isnan(fallback.cx) &&
+                              std::isnan(fallback.cy));
+  if (has_fallback && check_intrinsics(fallback) != IntrinsicsCheck::ok) {
+    return invalid(std::string("fallback_intrinsics: ") + intrinsics_check_name(check_intrinsics(fallback)));
+  }
+
+  impl_ = std::make_unique<Impl>();
+  Impl& m = *impl_;
+  m.recording = c.source == Openni2Source::recording;
+  m.stepped = m.recording && c.playback == Openni2Playback::stepped;
+  m.step_timeout_ms = static_cast<int>(std::ceil(c.step_timeout_s * 1000));
+
+  std::string uri;
+  const OniNodeInfo* depth_node = nullptr;
+  if (m.recording) {
+    std::error_code ec;
+    std::filesystem::path path = std::filesystem::absolute(c.location, ec);
+    if (ec) return invalid("cannot resolve the path \"" + c.location + "\"");
+    uri = path.lexically_normal().string();
+    if (uri.size() > 255) return invalid("recording path longer than OpenNI2's 255-byte URI limit: " + uri);
+    const OniCheckResult check = check_oni_file(uri, recording_info_);
+    last_check_ = check.status;
+    if (!check.ok()) {
+      last_error_ = "recording refused: " + check.message;
+      return HalStatus::io_error;
+    }
+    depth_node = recording_info_.first_node_of_type(kOniNodeDepth);
+    if (depth_node == nullptr) {
+      last_error_ = "recording \"" + uri + "\" has no depth stream";
+      return HalStatus::io_error;
+    }
+    m.last_frame_number = depth_node->last_frame;
+  }
+
+  std::string error;
+  if (!detail::ensure_openni2(error)) {
+    last_error_ = error;
+    return HalStatus::io_error;
+  }
+
+  if (!m.recording) {
+    uri = c.location;
+    if (uri == "any") {
+      openni::Array<openni::DeviceInfo> devices;
+      openni::OpenNI::enumerateDevices(&devices);
+      uri.clear();
+      for (int i = 0; i < devices.getSize() && uri.empty(); ++i) {
+        const char* candidate = devices[i].getUri();
+        if (candidate == nullptr || is_dummy_uri(candidate) || devices[i].getUsbVendorId() == 0) continue;
+        std::error_code ec;
+        if (std::filesystem::exists(candidate, ec)) continue;  // a recording opened earlier
+        uri = candidate;
+      }
+      if (uri.empty()) {
+        last_error_ = "no OpenNI2 depth camera connected (OpenNI2 enumerates " + std::to_string(devices.getSize()) +
+                      " device(s), none a USB camera; the Dummy test device must be opened by URI \"Dummy\")";
+        return HalStatus::disconnected;
+      }
+    }
+  }
+
+  if (m.device.open(uri.c_str()) != openni::STATUS_OK) {
+    last_error_ = "OpenNI2 cannot open \"" + uri + "\": " + extended_error();
+    return m.recording ? HalStatus::io_error : HalStatus::disconnected;
+  }
+  m.device_open = true;
+  m.dummy = !m.recording && is_dummy_uri(uri.c_str());
+  if (m.device.isFile() != m.recording) {
+    last_error_ = m.recording ? "\"" + uri + "\" did not open as a recording" : "\"" + uri + "\" is a recording, not a device";
+    return HalStatus::invalid_argument;
+  }
+  m.events = std::make_unique<detail::DeviceEvents>(m.device.getDeviceInfo().getUri());
+  if (!m.events->attach()) {
+    last_error_ = "OpenNI2 refused the device event listener: " + extended_error();
+    return HalStatus::io_error;
+  }
+
+  if (m.recording) {
+    // Before the stream exists, so that the player never starts in its default repeat mode.
+    openni::PlaybackControl* playback = m.device.getPlaybackControl();
+    if (playback == nullptr || playback->setRepeatEnabled(false) != openni::STATUS_OK ||
+        playback->setSpeed(m.stepped ? -1.0f : static_cast<float>(c.playback_speed)) != openni::STATUS_OK) {
+      last_error_ = "OpenNI2 refused the playback settings for \"" + uri + "\": " + extended_error();
+      return HalStatus::io_error;
+    }
+  }
+
+  if (m.device.getSensorInfo(openni::SENSOR_DEPTH) == nullptr || m.stream.create(m.device, openni::SENSOR_DEPTH) != openni::STATUS_OK) {
+    last_error_ = "\"" + uri + "\" has no depth sensor: " + extended_error();
+    return HalStatus::unsupported;
+  }
+  m.stream_created = true;
+
+  if (!m.recording && (c.width != 0 || c.height != 0 || c.fps != 0)) {
+    const openni::SensorInfo& sensor = m.stream.getSensorInfo();
+    const openni::Array<openni::VideoMode>& modes = sensor.getSupportedVideoModes();
+    const openni::VideoMode current = m.stream.getVideoMode();
+    int chosen = -1;
+    for (int i = 0; i < modes.getSize(); ++i) {
+      const openni::VideoMode& mode = modes[i];
+      if (depth_scale_of(mode.getPixelFormat()) == 0) continue;
+      if ((c.width != 0 && mode.getResolutionX() != c.width) || (c.height != 0 && mode.getResolutionY() != c.height) ||
+          (c.fps != 0 && mode.getFps() != c.fps)) {
+        continue;
+      }
+      // Prefer millimetres, then the current format.
+      if (chosen < 0 || (mode.getPixelFormat() == openni::PIXEL_FORMAT_DEPTH_1_MM &&
+                         modes[chosen].getPixelFormat() != openni::PIXEL_FORMAT_DEPTH_1_MM)) {
+        chosen = i;
+      }
+    }
+    if (chosen < 0) {
+      last_error_ = "\"" + uri + "\" has no millimetre depth mode " + std::to_string(c.width) + "x" +
+                    std::to_string(c.height) + " @ " + std::to_string(c.fps) + " Hz (0: any)";
+      return HalStatus::unsupported;
+    }
+    const openni::VideoMode& mode = modes[chosen];
+    const bool same = mode.getResolutionX() == current.getResolutionX() &&
+                      mode.getResolutionY() == current.getResolutionY() && mode.getFps() == current.getFps() &&
+                      mode.getPixelFormat() == current.getPixelFormat();
+    if (!same && m.stream.setVideoMode(mode) != openni::STATUS_OK) {
+      last_error_ = "\"" + uri + "\" refused the depth mode: " + extended_error();
+      return HalStatus::unsupported;
+    }
+  }
+
+  const openni::VideoMode mode = m.stream.getVideoMode();
+  m.format = mode.getPixelFormat();
+  m.depth_scale_m = depth_scale_of(m.format);
+  if (m.depth_scale_m == 0) {
+    last_error_ = "\"" + uri + "\" streams depth in pixel format " + std::to_string(static_cast<int>(m.format)) +
+                  ", not DEPTH_1_MM or DEPTH_100_UM";
+    return HalStatus::unsupported;
+  }
+  m.width = mode.getResolutionX();
+  m.height = mode.getResolutionY();
+  if (m.width < 1 || m.height < 1 || m.width > kMaxDepthSide || m.height > kMaxDepthSide) {
+    last_error_ = "\"" + uri + "\" reports a depth size of " + std::to_string(m.width) + "x" + std::to_string(m.height);
+    return HalStatus::unsupported;
+  }
+
+  float hfov = 0, vfov = 0;
+  const bool has_h = m.stream.getProperty(ONI_STREAM_PROPERTY_HORIZONTAL_FOV, &hfov) == openni::STATUS_OK;
+  const bool has_v = m.stream.getProperty(ONI_STREAM_PROPERTY_VERTICAL_FOV, &vfov) == openni::STATUS_OK;
+  m.stats.hfov_rad = has_h ? static_cast<double>(hfov) : std::numeric_limits<double>::quiet_NaN();
+  m.stats.vfov_rad = has_v ? static_cast<double>(vfov) : std::numeric_limits<double>::quiet_NaN();
+  DepthIntrinsics from_fov;
+  if (has_h && has_v && intrinsics_from_fov(m.stats.hfov_rad, m.stats.vfov_rad, m.width, m.height, from_fov) == IntrinsicsCheck::ok) {
+    m.intrinsics = from_fov;
+    m.stats.intrinsics_source = IntrinsicsSource::device_fov;
+  } else if (has_fallback) {
+    if (fallback.width != m.width || fallback.height != m.height) {
+      return invalid("fallback_intrinsics are for " + std::to_string(fallback.width) + "x" + std::to_string(fallback.height) +
+                     ", the stream is " + std::to_string(m.width) + "x" + std::to_string(m.height));
+    }
+    m.intrinsics = fallback;
+    m.stats.intrinsics_source = IntrinsicsSource::configured;
+  } else {
+    m.intrinsics = DepthIntrinsics{};
+    m.intrinsics.width = m.width;
+    m.intrinsics.height = m.height;
+    m.stats.intrinsics_source = IntrinsicsSource::none;
+  }
+
+  if (m.recording) {
+    // At least three of the file's largest frame intervals (at the playback speed).
+    const double largest_gap_s = static_cast<double>(depth_node->max_timestamp_step_us) * 1e-6 / c.playback_speed;
+    m.stall_timeout_s = std::max(c.stall_timeout_s, 3 * largest_gap_s);
+  }
+  m.image.assign(static_cast<std::size_t>(m.width) * static_cast<std::size_t>(m.height), 0);
+  return HalStatus::ok;
+}
+
+HalStatus Openni2Camera::on_start() noexcept {
+  Impl& m = *impl_;
+  if (!m.stats.end_of_stream) {
+    if (m.stream.start() != openni::STATUS_OK) {
+      last_error_ = "OpenNI2 cannot start the depth stream: " + extended_error();
+      return HalStatus::io_error;
+    }
+    m.stream_running = true;
+  }
+  const double now_s = clock_.now_s();
+  if (!m.have_anchor) {
+    m.anchor_s = now_s;
+    m.have_anchor = true;
+  } else {
+    m.paused_s += now_s - m.clock_at_stop_s;
+  }
+  m.have_offset = false;  // a pause would otherwise count as transport delay
+  m.received_at_start = m.stats.received;
+  m.last_progress = std::chrono::steady_clock::now();
+  return HalStatus::ok;
+}
+
+HalStatus Openni2Camera::on_stop() noexcept {
+  Impl& m = *impl_;
+  // DummyDevice's frame thread sets its running flag only once it is scheduled: a stop before
+  // that is lost and the thread would outlive the stream. One frame proves it is running.
+  if (m.dummy && m.stream_running && m.stats.received == m.received_at_start) {
+    openni::VideoStream* streams[1] = {&m.stream};
+    int ready = -1;
+    (void)openni::OpenNI::waitForAnyStream(streams, 1, &ready, 500);
+  }
+  m.stop_stream();
+  m.frame.release();
+  m.clock_at_stop_s = clock_.now_s();
+  return HalStatus::ok;
+}
+
+HalStatus Openni2Camera::on_cleanup() noexcept {
+  impl_->teardown(config_.teardown_grace_s);
+  impl_.reset();
+  return HalStatus::ok;
+}
+
+HalStatus Openni2Camera::on_read(hal::DepthFrame& out) noexcept {
+  Impl& m = *impl_;
+  if (m.stats.device_lost) return HalStatus::disconnected;
+  if (m.events->disconnected() && !m.recording) {
+    m.stats.device_lost = true;
+    return HalStatus::disconnected;
+  }
+  if (m.stats.end_of_stream || !m.stream_running) return HalStatus::no_data;
+
+  const auto end_stream = [&m](bool early) {
+    m.stats.end_of_stream = true;
+    m.stats.ended_early = early;
+    m.stop_stream();
+  };
+  // Read the end-of-file flag before looking for a frame: the player raises it only after
+  // handing over its last frame, so "flag set and nothing pending" means nothing will come.
+  const bool end_of_file = m.recording && m.events->end_of_file();
+  openni::VideoStream* streams[1] = {&m.stream};
+  int ready = -1;
+  const int timeout_ms = (m.stepped && !end_of_file) ? m.step_timeout_ms : 0;
+  const openni::Status waited = openni::OpenNI::waitForAnyStream(streams, 1, &ready, timeout_ms);
+  if (waited == openni::STATUS_TIME_OUT) {
+    if (m.recording) {
+      const double silent_s = seconds_since(m.last_progress, std::chrono::steady_clock::now());
+      if (end_of_file || m.stepped || silent_s > m.stall_timeout_s) {
+        end_stream(m.stats.last_frame_index < static_cast<int>(m.last_frame_number));
+      }
+    }
+    return HalStatus::no_data;
+  }
+  if (waited != openni::STATUS_OK) return HalStatus::io_error;
+  if (m.stream.readFrame(&m.frame) != openni::STATUS_OK || !m.frame.isValid()) return HalStatus::io_error;
+  ++m.stats.received;
+  m.last_progress = std::chrono::steady_clock::now();
+
+  const int index = m.frame.getFrameIndex();
+  const std::uint64_t ts_us = m.frame.getTimestamp();
+  const openni::VideoMode mode = m.frame.getVideoMode();
+  const bool copied =
+      m.frame.getWidth() == m.width && m.frame.getHeight() == m.height && mode.getPixelFormat() == m.format &&
+      m.frame.getStrideInBytes() > 0 && m.frame.getDataSize() > 0 &&
+      copy_depth_image(static_cast<const std::uint8_t*>(m.frame.getData()), static_cast<std::size_t>(m.frame.getDataSize()),
+                       m.width, m.height, static_cast<std::size_t>(m.frame.getStrideInBytes()), m.image.data(), m.image.size());
+  m.frame.release();
+  // The last frame of a recording: stop the stream now (the player would spin on the file end).
+  const bool last = m.recording && index >= 0 && static_cast<std::uint32_t>(index) >= m.last_frame_number;
+  if (!copied) {
+    ++m.stats.rejected;
+    if (last) end_stream(true);
+    return HalStatus::no_data;
+  }
+
+  // Sequence number from the frame index (see the header).
+  if (!m.have_index) {
+    m.index_base = m.recording ? 0 : static_cast<std::int64_t>(index) - 1;
+    m.have_index = true;
+  }
+  std::int64_t sequence = static_cast<std::int64_t>(index) - m.index_base;
+  if (sequence <= static_cast<std::int64_t>(m.last_sequence)) {
+    ++m.stats.index_resets;
+    sequence = static_cast<std::int64_t>(m.last_sequence) + 1;
+    m.index_base = static_cast<std::int64_t>(index) - sequence;
+  }
+  m.last_sequence = static_cast<std::uint64_t>(sequence);
+
+  // Stamp on the HAL clock (see the header).
+  const double ts_s = static_cast<double>(ts_us) * 1e-6;
+  double stamp_s = 0;
+  if (m.stepped) {
+    if (!m.have_first_ts) {
+      m.first_ts_us = ts_us;
+      m.have_first_ts = true;
+    }
+    stamp_s = m.anchor_s + m.paused_s + (ts_s - static_cast<double>(m.first_ts_us) * 1e-6);
+  } else {
+    const double observed = clock_.now_s() - ts_s;
+    if (!m.have_offset || observed < m.offset_s) m.offset_s = observed;
+    m.have_offset = true;
+    stamp_s = ts_s + m.offset_s;
+  }
+
+  m.stats.last_frame_index = index;
+  m.stats.last_timestamp_us = ts_us;
+  out.header.stamp_s = stamp_s;
+  out.header.sequence = m.last_sequence;
+  out.header.status_bits = 0;
+  out.width = m.width;
+  out.height = m.height;
+  out.stride_bytes = 2 * m.width;
+  out.depth_scale_m = m.depth_scale_m;
+  out.data = m.image.data();
+  out.fx = m.intrinsics.fx;
+  out.fy = m.intrinsics.fy;
+  out.cx = m.intrinsics.cx;
+  out.cy = m.intrinsics.cy;
+  if (last) end_stream(false);
+  return HalStatus::ok;
+}
+
+}  // namespace pliant::drivers::openni2
