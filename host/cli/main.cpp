@@ -4,14 +4,17 @@
 
 #include <CLI/CLI.hpp>
 
+#include "command_devices.hpp"
 #include "command_diagnose.hpp"
 #include "command_estimate.hpp"
 #include "command_import.hpp"
+#include "command_record.hpp"
 #include "command_refine.hpp"
 #include "command_replay.hpp"
 #include "command_simulate.hpp"
 #include "command_telemetry.hpp"
 #include "command_track.hpp"
+#include "command_track_depth.hpp"
 #include "exit_status.hpp"
 
 namespace pliant::cli {
@@ -47,7 +50,10 @@ int run(int argc, char** argv) {
   RefineCommand refine(app);
   TelemetryCommand telemetry(app);
   TrackCommand track(app);
+  TrackDepthCommand track_depth(app);
   ReplayCommand replay(app);
+  DevicesCommand devices(app);
+  RecordCommand record(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& done) {  // --help, --version
@@ -62,7 +68,10 @@ int run(int argc, char** argv) {
   if (refine.selected()) return run_reporting_errors("pliant refine", [&] { return refine.run(); });
   if (telemetry.selected()) return run_reporting_errors("pliant telemetry", [&] { return telemetry.run(); });
   if (track.selected()) return run_reporting_errors("pliant track", [&] { return track.run(); });
+  if (track_depth.selected()) return run_reporting_errors("pliant track-depth", [&] { return track_depth.run(); });
   if (replay.selected()) return run_reporting_errors("pliant replay", [&] { return replay.run(); });
+  if (devices.selected()) return run_reporting_errors("pliant devices", [&] { return devices.run(); });
+  if (record.selected()) return run_reporting_errors("pliant record", [&] { return record.run(); });
   std::cerr << app.help();
   return exit_usage;
 }

@@ -1,0 +1,42 @@
+// `pliant track-depth PLAN DEPTH_LIST -o DIR`: a depth image sequence tracked into a 3D
+// recording (host/vision/depth, docs/vision_depth.md).
+#pragma once
+
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+namespace pliant::cli {
+
+class TrackDepthCommand {
+ public:
+  /// Registers the subcommand and its options on `parent`.
+  explicit TrackDepthCommand(CLI::App& parent);
+
+  bool selected() const { return app_->parsed(); }
+  /// Runs after a successful parse; throws on failure (see exit_status.hpp for the mapping).
+  int run() const;
+
+ private:
+  CLI::App* app_ = nullptr;
+  std::string plan_;
+  std::string depth_list_;
+  std::string output_;
+  std::string intrinsics_;
+  std::string camera_pose_;
+  std::string region_;
+  std::string correspondence_ = "plane";
+  double units_per_metre_ = 1000.0;
+  int stride_ = 1;
+  double min_depth_m_ = 0.0;
+  double max_depth_m_ = 0.0;
+  double noise_m_ = 1e-3;
+  double msm_beta_ = 0.5;
+  double time_offset_s_ = 0.0;
+  int rounds_ = 1;
+  int reference_frames_ = 15;
+  bool all_tracked_ = false;
+  bool force_ = false;
+};
+
+}  // namespace pliant::cli

@@ -1,0 +1,138 @@
+// Advection, forward-backward and appearance checks, and the search for hidden particles.
+#include <cmath>
+#include <string>
+
+#include "pliant/vision/webcam_advection.hpp"
+#include "pliant/vision/webcam_error.hpp"
+
+namespace pliant::vision::webcam {
+namespace {
+
+bool inside(const cv::Mat& frame, const cv::Point2d& p) {
+  return std::isfinite(p.x) && std::isfinite(p.y) && p.x >= -0.5 && p.y >= -0.5 && p.x <= frame.cols - 0.5 &&
+         p.y <= frame.rows - 0.5;
+}
+
+}  // namespace
+
+const char* observation_kind_name(ObservationKind kind) {
+  switch (kind) {
+    case ObservationKind::advected: return "advected";
+    case ObservationKind::found: return "found";
+    case ObservationKind::inconsistent: return "inconsistent";
+    case ObservationKind::dissimilar: return "dissimilar";
+    case ObservationKind::outside: return "outside";
+    case ObservationKind::not_found: return "not_found";
+  }
+  return "unknown";
+}
+
+void check_advection_config(const AdvectionConfig& c) {
+  if (c.window_px < 1 || c.window_px > 101) throw InputError("--window must be between 1 and 101 px");
+  if (!(std::isfinite(c.fb_threshold_px) && c.fb_threshold_px > 0)) throw InputError("--fb-threshold must be > 0 px");
+  if (!(c.min_similarity > -1 && c.min_similarity <= 1)) throw InputError("--min-similarity must be in (-1, 1]");
+  if (c.patch_px < 5 || c.patch_px > 101 || c.patch_px % 2 == 0) throw InputError("patch size must be odd, 5..101 px");
+  if (!(c.refresh_similarity >= c.min_similarity && c.refresh_similarity <= 1)) {
+    throw InputError("the template refresh similarity must be in [min similarity, 1]");
+  }
+  if (c.search_radius_px < 0 || c.search_radius_px > 50) throw InputError("--search-radius must be 0..50 px");
+  if (c.dis_finest_scale < -1 || c.dis_finest_scale > 4) throw InputError("DIS finest scale must be 0..4 (or -1: from the spacing)");
+}
+
+FlowAdvector::FlowAdvector(FlowMethod method, const AdvectionConfig& config)
+    : flow_(method, config.dis_finest_scale < 0 ? 2 : config.dis_finest_scale), config_(config) {
+  check_advection_config(config_);
+}
+
+void FlowAdvector::start(const cv::Mat& grey, const std::vector<cv::Point2d>& positions) {
+  CV_Assert(grey.type() == CV_8UC1);
+  grey.copyTo(previous_);
+  templates_.assign(positions.size(), cv::Mat());
+  for (std::size_t i = 0; i < positions.size(); ++i) extract_patch(previous_, positions[i], config_.patch_px, templates_[i]);
+}
+
+PatchMatch FlowAdvector::search(const cv::Mat& templ, const cv::Point2d& a, const cv::Point2d& b) const {
+  PatchMatch best;
+  best.position = cv::Point2d(ParticleObservation::kNaN, ParticleObservation::kNaN);
+  for (const cv::Point2d& centre : {a, b}) {
+    if (!inside(next_, centre)) continue;
+    const PatchMatch match = search_patch(next_, templ, centre, config_.search_radius_px);
+    if (match.similarity > best.similarity && inside(next_, match.position)) best = match;
+    // The same centre twice (prediction = advection) needs one search only.
+    if (std::hypot(a.x - b.x, a.y - b.y) < 0.5) break;
+  }
+  return best;
+}
+
+void FlowAdvector::observe(const cv::Mat& next, const std::vector<cv::Point2d>& positions,
+                           const std::vector<cv::Point2d>& predicted, const std::vector<std::uint8_t>& seen,
+                           std::vector<ParticleObservation>& out) {
+  const std::size_t n = templates_.size();
+  CV_Assert(next.type() == CV_8UC1 && next.size() == previous_.size() && positions.size() == n &&
+            predicted.size() == n && seen.size() == n);
+  next.copyTo(next_);
+  flow_.compute(previous_, next_, forward_);
+  if (config_.forward_backward) {
+    flow_.compute(next_, previous_, backward_);
+  } else {
+    backward_.release();
+  }
+  out.assign(n, ParticleObservation{});
+  for (std::size_t i = 0; i < n; ++i) {
+    ParticleObservation& o = out[i];
+    const cv::Point2d p = positions[i];
+    const cv::Point2d expected = std::isfinite(predicted[i].x) && std::isfinite(predicted[i].y) ? predicted[i] : p;
+    cv::Point2d q = expected;
+    if (inside(previous_, p)) q = p + window_mean_flow(forward_, p, config_.window_px);
+    if (!inside(next_, q) && !inside(next_, expected)) {
+      o.kind = ObservationKind::outside;
+      continue;
+    }
+    if (seen[i] != 0) {
+      if (!inside(previous_, p) || !inside(next_, q)) {
+        o.kind = ObservationKind::outside;
+        continue;
+      }
+      if (config_.forward_backward) {
+        const cv::Point2d back = q + window_mean_flow(backward_, q, config_.window_px);
+        o.fb_error_px = std::hypot(back.x - p.x, back.y - p.y);
+      }
+      extract_patch(next_, q, config_.patch_px, patch_);
+      o.similarity = patch_similarity(templates_[i], patch_);
+      const bool consistent = !config_.forward_backward || o.fb_error_px <= config_.fb_threshold_px;
+      if (consistent && o.similarity >= config_.min_similarity) {
+        o.kind = ObservationKind::advected;
+        o.position = q;
+      } else {
+        o.kind = consistent ? ObservationKind::dissimilar : ObservationKind::inconsistent;
+      }
+      continue;
+    }
+    // Not seen in the previous frame: look for its template.
+    const PatchMatch match = search(templates_[i], q, expected);
+    o.similarity = match.similarity;
+    if (match.similarity >= config_.min_similarity) {
+      o.kind = ObservationKind::found;
+      o.position = match.position;
+    } else {
+      o.kind = ObservationKind::not_found;
+    }
+  }
+  last_similarity_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) last_similarity_[i] = out[i].similarity;
+}
+
+void FlowAdvector::commit(const std::vector<cv::Point2d>& positions, const std::vector<std::uint8_t>& refresh) {
+  CV_Assert(positions.size() == templates_.size() && refresh.size() == templates_.size());
+  for (std::size_t i = 0; i < templates_.size(); ++i) {
+    // A template follows slow changes of appearance (deformation) but not a sudden one (an
+    // occluder partly over the patch), which would teach it the occluder.
+    const bool similar = i < last_similarity_.size() && last_similarity_[i] >= config_.refresh_similarity;
+    if (refresh[i] != 0 && similar && inside(next_, positions[i])) {
+      extract_patch(next_, positions[i], config_.patch_px, templates_[i]);
+    }
+  }
+  std::swap(previous_, next_);
+}
+
+}  // namespace pliant::vision::webcam

@@ -1,0 +1,156 @@
+// The webcam tracker against a rendered press whose particle paths and msm_beta are known
+// (press_scene.hpp): tracking error, detected roles, msm_beta through the estimator, and a
+// moving occluder.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "press_scene.hpp"
+#include "pliant/host/estimate.hpp"
+#include "pliant/vision/webcam_recording.hpp"
+#include "pliant/vision/webcam_tracker.hpp"
+
+namespace pliant::vision::webcam {
+namespace {
+
+constexpr double kBetaTolerance = 0.05;
+
+test::PressSceneConfig occluded_config() {
+  test::PressSceneConfig config;
+  // 40 x 50 px, over rows 1 and 2 (y 104.5 and 134.5), crossing the grid at 10 px per frame
+  // while the press goes on: each particle of those rows is hidden for about 4 frames.
+  config.occluder_width = 40;
+  config.occluder_height = 50;
+  config.occluder_y = 95;
+  config.occluder_x0 = 0;
+  config.occluder_speed_px = 10;
+  config.occluder_from = 4;
+  return config;
+}
+
+struct Tracked {
+  test::PressScene scene;
+  TrackResult result;
+};
+
+Tracked track_scene(const test::PressSceneConfig& config, FlowMethod method) {
+  test::PressScene scene(config);
+  MemoryFrameSource source(scene.render_all(), config.rate_hz, "press scene");
+  FrameReader reader(source, 0);
+  TrackOptions options;
+  options.flow = method;
+  TrackResult result = track_particles(reader, parse_roi(scene.roi()), parse_grid(scene.grid()), options);
+  return {std::move(scene), std::move(result)};
+}
+
+double error_px(const Tracked& t, int frame, int id) {
+  const cv::Point2d d = t.result.tracked[t.result.at(frame, id)] - t.scene.truth(frame, id);
+  return std::hypot(d.x, d.y);
+}
+
+struct ErrorSummary {
+  double median = 0, p90 = 0, max = 0;
+};
+
+ErrorSummary summarize(const Tracked& t) {
+  std::vector<double> errors;
+  for (int f = 0; f < t.result.frame_count(); ++f) {
+    for (int i = 0; i < t.result.particle_count(); ++i) errors.push_back(error_px(t, f, i));
+  }
+  std::sort(errors.begin(), errors.end());
+  return {errors[errors.size() / 2], errors[errors.size() * 9 / 10], errors.back()};
+}
+
+double estimated_beta(const TrackResult& result) {
+  const host::Recording recording = track_recording(result, "press");
+  return host::estimate_recording(recording, host::EstimateOptions{}).result.msm_beta;
+}
+
+void expect_press_roles(const Tracked& t) {
+  EXPECT_TRUE(t.result.roles.support_detected);
+  EXPECT_EQ(t.result.roles.support_side, GridSide::bottom);
+  EXPECT_EQ(t.result.roles.support, t.scene.base());
+  EXPECT_TRUE(t.result.roles.driven_detected);
+  EXPECT_EQ(t.result.roles.driven, t.scene.tool());
+}
+
+TEST(webcam_truth, PressIsTrackedWithinHalfAPixelAndGivesItsMsmBeta) {
+  const test::PressSceneConfig config;
+  const Tracked t = track_scene(config, FlowMethod::dis);
+  ASSERT_EQ(t.result.frame_count(), t.scene.frame_count());
+  ASSERT_EQ(t.result.particle_count(), t.scene.particle_count());
+  // The tracker starts from the seeds, which the scene puts on its particles.
+  for (int i = 0; i < t.result.particle_count(); ++i) EXPECT_LT(error_px(t, 0, i), 1e-9);
+  const ErrorSummary e = summarize(t);
+  std::printf("DIS press: error median %.3f px, p90 %.3f px, max %.3f px (tool moves %.1f px)\n", e.median, e.p90,
+              e.max, config.depth_px);
+  EXPECT_LE(e.median, 0.5);
+  EXPECT_LE(e.max, 1.5);
+  expect_press_roles(t);
+  const double beta = estimated_beta(t.result);
+  std::printf("DIS press: msm_beta %.4f (rendered %.2f)\n", beta, config.msm_beta);
+  EXPECT_NEAR(beta, config.msm_beta, kBetaTolerance);
+}
+
+TEST(webcam_truth, FarnebackTracksThePressToo) {
+  const test::PressSceneConfig config;
+  const Tracked t = track_scene(config, FlowMethod::farneback);
+  const ErrorSummary e = summarize(t);
+  std::printf("Farneback press: error median %.3f px, p90 %.3f px, max %.3f px\n", e.median, e.p90, e.max);
+  EXPECT_LE(e.median, 0.5);
+  expect_press_roles(t);
+  const double beta = estimated_beta(t.result);
+  std::printf("Farneback press: msm_beta %.4f (rendered %.2f)\n", beta, config.msm_beta);
+  EXPECT_NEAR(beta, config.msm_beta, kBetaTolerance);
+}
+
+TEST(webcam_truth, OccludedParticlesAreUnobservedWhileHiddenAndRecoveredAfter) {
+  const test::PressSceneConfig config = occluded_config();
+  const Tracked t = track_scene(config, FlowMethod::dis);
+  const TrackResult& r = t.result;
+  const int frames = r.frame_count();
+  int hidden_frames = 0, recovered = 0, hidden_particles = 0;
+  for (int i = 0; i < r.particle_count(); ++i) {
+    int last_hidden = -1;
+    for (int f = 0; f < frames; ++f) {
+      // Fully hidden: its appearance patch (11 px) is inside the occluder.
+      if (t.scene.hidden(f, i, -6)) {
+        ++hidden_frames;
+        last_hidden = f;
+        EXPECT_EQ(r.observed[r.at(f, i)], 0) << "particle " << i << " frame " << f << " is hidden but observed";
+      }
+      // The tracker never loses it: bounded by a tenth of the spacing throughout.
+      EXPECT_LT(error_px(t, f, i), 0.1 * config.spacing_px) << "particle " << i << " frame " << f;
+    }
+    if (last_hidden < 0) continue;
+    ++hidden_particles;
+    // Clear of the occluder (and its flow) from some frame on: observed again within 3 frames.
+    int clear_from = -1;
+    for (int f = last_hidden + 1; f < frames && clear_from < 0; ++f) {
+      if (!t.scene.hidden(f, i, 12)) clear_from = f;
+    }
+    if (clear_from < 0 || clear_from + 3 >= frames) continue;
+    bool seen_again = false;
+    for (int f = clear_from; f <= clear_from + 3; ++f) seen_again = seen_again || r.observed[r.at(f, i)] != 0;
+    EXPECT_TRUE(seen_again) << "particle " << i << " not recovered after frame " << clear_from;
+    EXPECT_EQ(r.observed[r.at(frames - 1, i)], 1) << "particle " << i << " unobserved at the end";
+    recovered += seen_again ? 1 : 0;
+  }
+  std::printf("occluder: %d particles hidden for %d particle-frames, %d recovered\n", hidden_particles, hidden_frames,
+              recovered);
+  EXPECT_GE(hidden_particles, 10);  // the scene does hide most of two rows
+  EXPECT_GE(recovered, 8);
+  const ErrorSummary e = summarize(t);
+  std::printf("occluder: error median %.3f px, p90 %.3f px, max %.3f px\n", e.median, e.p90, e.max);
+  EXPECT_LE(e.median, 0.5);
+  expect_press_roles(t);
+  const double beta = estimated_beta(r);
+  std::printf("occluder: msm_beta %.4f (rendered %.2f)\n", beta, config.msm_beta);
+  EXPECT_NEAR(beta, config.msm_beta, kBetaTolerance);
+}
+
+}  // namespace
+}  // namespace pliant::vision::webcam
