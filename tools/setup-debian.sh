@@ -17,6 +17,7 @@ packages=(
   chromium                       # headless browser for the report rendering test
   libopencv-dev                  # vision front end (dense optical flow) and the opencv driver
   libnanoflann-dev               # kd-tree for the depth tracker's correspondences
+  libpng-dev                     # 16-bit depth PNGs (the depth front end decodes them with libpng)
   libmodbus-dev                  # modbus driver: Robotiq grippers and FT 300, and its test emulator
   libusb-1.0-0-dev               # usb driver: device discovery and hotplug
   libopenni2-dev                 # openni2 driver: depth cameras and .oni playback

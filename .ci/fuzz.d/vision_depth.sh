@@ -2,7 +2,7 @@
 # 1 frame list, 2 intrinsics, 3 camera pose, 4 region. Built only when tests/fuzz/CMakeLists.txt
 # includes tests/fuzz/vision/depth.cmake. Seeds: a 4x3 16-bit PNG, the same cut short, a TUM list,
 # and one valid and one malformed text of each kind.
-if cmake --build "$build" --target help | grep -q 'vision_depth_fuzz'; then
+if cmake --build "$build" --target help 2>/dev/null | grep 'vision_depth_fuzz' >/dev/null; then
   cmake --build "$build" --target vision_depth_fuzz -j "$(nproc)"
   depth_fuzzer="$build/bin/vision_depth_fuzz"
   [ -x "$depth_fuzzer" ] || depth_fuzzer="$(find "$build" -type f -name vision_depth_fuzz -perm -u+x | head -n 1)"

@@ -70,7 +70,7 @@ TrackDepthCommand::TrackDepthCommand(CLI::App& parent) {
       ->capture_default_str();
   app_->add_option("--correspondence", correspondence_,
                    "'plane': each particle's prediction projected onto the local surface plane (normal motion); "
-                   "'point': its nearest cloud point")
+                   "'point': the mean of its nearest cloud points")
       ->type_name("plane|point")
       ->capture_default_str();
   app_->add_option("--noise", noise_m_, "Depth noise sd at the object's distance, m (floor of the correspondence scale)")

@@ -212,6 +212,7 @@ TEST(DepthCloud, IntrinsicsFromText) {
   EXPECT_EQ(message("1,2,3,4,5"), "intrinsics: trailing text after cy (expected fx,fy,cx,cy)");
   EXPECT_EQ(message("1,2,3,4x"), "intrinsics: cy is not a number: '4x'");
   EXPECT_EQ(message("0,1,2,3"), "intrinsics: fx must be finite and > 0 (missing intrinsics?)");
+  EXPECT_EQ(message("1,2,3,\n4"), "intrinsics: cy is not a number: '\\x0a4'");  // one line, always
   EXPECT_NE(message("1e999,1,2,3").find("not a number"), std::string::npos);
   EXPECT_NE(message("nan,1,2,3").find("fx"), std::string::npos);
   EXPECT_NE(error_of([] { parse_intrinsics("1,1,1,1", 0, 480); }).find("width"), std::string::npos);
@@ -290,6 +291,22 @@ TEST(DepthPng, ReadsSixteenBitAndRefusesTheRest) {
   // Too large: a 20000 x 1 image is refused before any buffer is allocated.
   cv::imwrite(dir / "wide.png", cv::Mat(1, 20000, CV_16UC1, cv::Scalar(1)));
   EXPECT_EQ(message(dir / "wide.png"), dir / "wide.png" + ": image of 20000x1 pixels is larger than 16384 on a side");
+  // A header claiming 16000 x 16000 pixels over a few bytes of data.
+  std::string claim = std::string(bytes.substr(0, 33));
+  claim[16] = claim[20] = 0;
+  claim[17] = claim[21] = 0;
+  claim[18] = claim[22] = static_cast<char>(16000 >> 8);
+  claim[19] = claim[23] = static_cast<char>(16000 & 0xff);
+  std::uint32_t crc = 0xffffffffu;  // PNG's CRC-32 over the chunk type and data
+  for (std::size_t i = 12; i < 29; ++i) {
+    crc ^= static_cast<std::uint8_t>(claim[i]);
+    for (int bit = 0; bit < 8; ++bit) crc = (crc >> 1) ^ (0xedb88320u & (0u - (crc & 1u)));
+  }
+  crc ^= 0xffffffffu;
+  for (int b = 0; b < 4; ++b) claim[static_cast<std::size_t>(29 + b)] = static_cast<char>((crc >> (24 - 8 * b)) & 0xff);
+  claim += std::string("\0\0\0\x64IDAT", 8) + std::string(100, '\0');
+  EXPECT_EQ(error_of([&] { decode_depth_png(reinterpret_cast<const std::uint8_t*>(claim.data()), claim.size(), "claim.png"); }),
+            "claim.png: corrupt PNG (141 bytes cannot hold a 16000x16000 image)");
   EXPECT_THROW(decode_depth_png(nullptr, 0, "x"), DepthError);
 }
 

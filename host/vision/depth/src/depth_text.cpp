@@ -1,5 +1,6 @@
 #include "pliant/vision/depth_text.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -10,6 +11,23 @@ namespace pliant::vision {
 namespace {
 
 bool blank(char c) { return c == ' ' || c == '\t'; }
+
+// A field for an error message: control bytes escaped, so the message stays one line.
+std::string printable(std::string_view text) {
+  static const char kHex[] = "0123456789abcdef";
+  std::string out;
+  for (const char c : text) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte < 0x20 || byte == 0x7f) {
+      out += "\\x";
+      out += kHex[byte >> 4];
+      out += kHex[byte & 0xf];
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
 
 // `count` comma-separated decimal numbers named by `names` (for messages); `what` names the list.
 template <std::size_t Count>
@@ -32,8 +50,13 @@ void parse_numbers(std::string_view text, const char* what, const char* const (&
     char* stop = nullptr;
     errno = 0;
     out[i] = std::strtod(field.c_str(), &stop);
-    if (piece.size() > 40 || stop != field.c_str() + field.size() || errno == ERANGE) {
-      throw DepthError(prefix + names[i] + " is not a number: '" + field + (piece.size() > 40 ? "...'" : "'"));
+    // strtod would skip leading whitespace such as a line break: a field holds no control byte.
+    const bool control = std::any_of(field.begin(), field.end(), [](char c) {
+      const auto byte = static_cast<unsigned char>(c);
+      return byte < 0x20 || byte == 0x7f;
+    });
+    if (piece.size() > 40 || control || stop != field.c_str() + field.size() || errno == ERANGE) {
+      throw DepthError(prefix + names[i] + " is not a number: '" + printable(field) + (piece.size() > 40 ? "...'" : "'"));
     }
     text.remove_prefix(end);
   }

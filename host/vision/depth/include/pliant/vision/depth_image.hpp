@@ -72,8 +72,9 @@ struct DepthImage {
 /// Reads a single-channel 16-bit PNG (the TUM, OpenNI and RealSense export format; interlaced
 /// or not), through libpng with its messages captured: nothing is printed. Throws DepthError
 /// naming the file: missing or unreadable, empty, not a PNG, corrupt ("corrupt PNG (<libpng's
-/// reason>)"), not 16-bit, not one grey channel, wider or taller than 16384 pixels. Allocates
-/// the image.
+/// reason>)"; also a file too small to hold the image its header claims, refused before the
+/// image is allocated), not 16-bit, not one grey channel, wider or taller than 16384 pixels.
+/// Allocates the image.
 DepthImage read_depth_png(const std::string& path);
 
 /// The same from PNG bytes in memory; `label` names the input in errors. Used by the fuzz target.
