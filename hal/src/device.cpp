@@ -96,7 +96,9 @@ void Device::account_read(HalStatus status, const SampleHeader& header) noexcept
     account_fault(status);
     return;
   }
-  if (unreachable_ && (status == HalStatus::ok || status == HalStatus::no_data)) {
+  // Only a delivered sample proves the device is back: a driver may answer no_data without any
+  // I/O (poll rate limits, reconnect back-off), which would count a reconnect per read.
+  if (unreachable_ && status == HalStatus::ok) {
     unreachable_ = false;
     ++counters_.reconnects;
   }

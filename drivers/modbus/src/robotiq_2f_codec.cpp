@@ -95,7 +95,8 @@ hal::HalStatus validate(const Scaling& c) noexcept {
 double position_to_width(std::uint8_t p, const Scaling& c) noexcept {
   const double span = static_cast<double>(c.closed_byte) - static_cast<double>(c.open_byte);
   if (span == 0 || !(c.stroke_m > 0)) return std::numeric_limits<double>::quiet_NaN();
-  const double w = c.stroke_m * (static_cast<double>(c.closed_byte) - static_cast<double>(p)) / span;
+  // The byte fraction first: stroke x (closed - p) overflows for strokes near DBL_MAX.
+  const double w = c.stroke_m * ((static_cast<double>(c.closed_byte) - static_cast<double>(p)) / span);
   if (w < 0) return 0;
   if (w > c.stroke_m) return c.stroke_m;
   return w;
@@ -108,7 +109,7 @@ std::uint8_t width_to_position(double width_m, const Scaling& c) noexcept {
   if (w > c.stroke_m) w = c.stroke_m;
   const double closed = static_cast<double>(c.closed_byte);
   const double open = static_cast<double>(c.open_byte);
-  const double p = closed - (closed - open) * w / c.stroke_m;  // between open and closed
+  const double p = closed - (closed - open) * (w / c.stroke_m);  // between open and closed
   if (!std::isfinite(p)) return c.open_byte;  // an infinite stroke (invalid scaling)
   const long r = std::lround(p);
   if (r < 0) return 0;

@@ -196,6 +196,15 @@ TEST(Robotiq2fCodec, PositionWidthScaling) {
   EXPECT_NEAR(r2f::position_to_width(116, cal), 0.140 * (230.0 - 116.0) / 227.0, 1e-12);
   EXPECT_DOUBLE_EQ(r2f::position_to_width(0, cal), 0.140);   // beyond the open end: clamped
   EXPECT_DOUBLE_EQ(r2f::position_to_width(255, cal), 0.0);  // beyond the closed end: clamped
+  // A valid but absurd stroke near DBL_MAX (found by the fuzzer): no overflow in the round trip.
+  r2f::Scaling huge;
+  huge.stroke_m = 1.0e308;
+  huge.open_byte = 127;
+  huge.closed_byte = 252;
+  for (int p = 127; p <= 252; ++p) {
+    const auto b = static_cast<std::uint8_t>(p);
+    EXPECT_EQ(r2f::width_to_position(r2f::position_to_width(b, huge), huge), b) << p;
+  }
 }
 
 TEST(Robotiq2fCodec, SpeedAndForceBytes) {

@@ -61,7 +61,7 @@ struct DeviceCounters {
   std::uint64_t device_faults = 0;     ///< ... device_fault
   std::uint64_t io_errors = 0;         ///< ... io_error
   std::uint64_t disconnects = 0;       ///< transitions from reachable to disconnected
-  std::uint64_t reconnects = 0;        ///< first successful read or write after a disconnect
+  std::uint64_t reconnects = 0;        ///< first delivered sample or accepted write after a disconnect
   std::uint64_t writes = 0;            ///< write calls while active
   std::uint64_t rejected_writes = 0;   ///< writes refused (invalid_argument, unsupported or a fault)
   std::uint64_t lifecycle_errors = 0;  ///< calls refused with wrong_state
