@@ -84,10 +84,11 @@ struct Timing {
 };
 
 Timing time_advection(const std::vector<cv::Mat>& frames, FlowMethod method, int finest_scale, bool forward_backward,
-                      double spacing) {
+                      double spacing, int refine_window_px = AdvectionConfig{}.refine_window_px) {
   AdvectionConfig config;
   config.dis_finest_scale = finest_scale;
   config.forward_backward = forward_backward;
+  config.refine_window_px = refine_window_px;
   FlowAdvector advector(method, config);
   std::vector<cv::Point2d> positions = grid_points(frames[0].size(), spacing);
   advector.start(frames[0], positions);
@@ -157,7 +158,8 @@ int main(int argc, char** argv) {
   }
   std::printf("webcam_track_bench (build type %s, OpenCV %s, %d OpenCV threads)\n", PLIANT_BENCH_BUILD_TYPE,
               CV_VERSION, cv::getNumThreads());
-  std::printf("per frame: flow + advection of a 4x8 grid (window 10 px, patch checks); wall and CPU (all threads)\n\n");
+  std::printf("per frame: flow + advection of a 4x8 grid (window 10 px, LK refinement %d px, patch checks); wall and CPU (all threads)\n\n",
+              AdvectionConfig{}.refine_window_px);
   std::printf("%-10s %-10s %-36s %8s %8s %8s %10s  %s\n", "frame", "flow", "settings", "wall ms", "wall f/s", "cpu ms",
               "2-core f/s", "target (CPU time)");
 
@@ -185,6 +187,8 @@ int main(int argc, char** argv) {
         "");
     row(c.name, "dis", "scale " + std::to_string(scale) + ", no fb check",
         time_advection(frames, FlowMethod::dis, scale, false, c.spacing), "");
+    row(c.name, "dis", "scale " + std::to_string(scale) + ", fb check, no LK refinement",
+        time_advection(frames, FlowMethod::dis, scale, true, c.spacing, 0), "");
     row(c.name, "farneback", "fb check (reference)",
         time_advection(std::vector<cv::Mat>(frames.begin(), frames.begin() + std::min<int>(c.frames, 11)),
                        FlowMethod::farneback, 2, true, c.spacing),

@@ -65,6 +65,10 @@ TrackCommand::TrackCommand(CLI::App& parent) {
   app_->add_option("--window", window_px_, "Flow averaging window around each particle, pixels (eq. 14)")
       ->type_name("PX")
       ->capture_default_str();
+  app_->add_option("--refine-window", refine_window_px_,
+                   "Lucas-Kanade window that refines each advected particle at full resolution, px (0: off)")
+      ->type_name("PX")
+      ->capture_default_str();
   app_->add_option("--fb-threshold", fb_threshold_px_, "Largest forward-backward flow error of an observation, px")
       ->type_name("PX")
       ->capture_default_str();
@@ -95,6 +99,7 @@ int TrackCommand::run() const {
     webcam::TrackOptions options;
     options.flow = webcam::parse_flow_method(flow_);
     options.advection.window_px = window_px_;
+    options.advection.refine_window_px = refine_window_px_;
     options.advection.fb_threshold_px = fb_threshold_px_;
     options.advection.min_similarity = min_similarity_;
     options.advection.refresh_similarity = std::max(options.advection.refresh_similarity, min_similarity_);

@@ -30,6 +30,7 @@ class TrackCommand {
   double rate_hz_ = 0;
   double fps_hz_ = 0;
   int window_px_ = 10;
+  int refine_window_px_ = 9;
   double fb_threshold_px_ = 1.0;
   double min_similarity_ = 0.8;
   double track_beta_ = 0.5;

@@ -120,6 +120,16 @@ TEST(webcam_flow, MethodNamesAndSettings) {
   bad = AdvectionConfig{};
   bad.refresh_similarity = 0.5;
   EXPECT_THROW(check_advection_config(bad), InputError);
+  for (int refine : {-1, 1, 2, 10, 53}) {
+    bad = AdvectionConfig{};
+    bad.refine_window_px = refine;
+    EXPECT_THROW(check_advection_config(bad), InputError) << refine;
+  }
+  AdvectionConfig good;
+  for (int refine : {0, 3, 9, 51}) {
+    good.refine_window_px = refine;
+    EXPECT_NO_THROW(check_advection_config(good)) << refine;
+  }
 }
 
 // Three particles over a texture moving right by 1 px per frame; a grey square then covers the

@@ -36,12 +36,13 @@ struct Tracked {
   TrackResult result;
 };
 
-Tracked track_scene(const test::PressSceneConfig& config, FlowMethod method) {
+Tracked track_scene(const test::PressSceneConfig& config, FlowMethod method, int refine_window_px = 9) {
   test::PressScene scene(config);
   MemoryFrameSource source(scene.render_all(), config.rate_hz, "press scene");
   FrameReader reader(source, 0);
   TrackOptions options;
   options.flow = method;
+  options.advection.refine_window_px = refine_window_px;
   TrackResult result = track_particles(reader, parse_roi(scene.roi()), parse_grid(scene.grid()), options);
   return {std::move(scene), std::move(result)};
 }
@@ -104,6 +105,71 @@ TEST(webcam_truth, FarnebackTracksThePressToo) {
   expect_press_roles(t);
   const double beta = estimated_beta(t.result);
   std::printf("Farneback press: msm_beta %.4f (rendered %.2f)\n", beta, config.msm_beta);
+  EXPECT_NEAR(beta, config.msm_beta, kBetaTolerance);
+}
+
+// Softer and stiffer objects than the default scene, with noisier frames (grey sd 3): the chain
+// must hold msm_beta over the range, not just at one value. Without the Lucas-Kanade refinement
+// the flow's smoothing of the peak under the tool pushes a rendered 0.2 to about 0.30.
+struct BetaCase {
+  double msm_beta;
+  double noise_grey;
+};
+
+class webcam_truth_beta : public ::testing::TestWithParam<BetaCase> {};
+
+TEST_P(webcam_truth_beta, ChainRecoversTheRenderedMsmBeta) {
+  test::PressSceneConfig config;
+  config.msm_beta = GetParam().msm_beta;
+  config.noise_grey = GetParam().noise_grey;
+  const Tracked t = track_scene(config, FlowMethod::dis);
+  const ErrorSummary e = summarize(t);
+  expect_press_roles(t);
+  EXPECT_LE(e.median, 0.5);
+  const double beta = estimated_beta(t.result);
+  std::printf("msm_beta %.2f, noise %.0f grey: error median %.3f px, max %.3f px; estimated %.4f\n", config.msm_beta,
+              config.noise_grey, e.median, e.max, beta);
+  EXPECT_NEAR(beta, config.msm_beta, kBetaTolerance);
+}
+
+INSTANTIATE_TEST_SUITE_P(range, webcam_truth_beta,
+                         ::testing::Values(BetaCase{0.2, 3}, BetaCase{0.8, 3}),
+                         [](const ::testing::TestParamInfo<BetaCase>& param) {
+                           return "beta_" + std::to_string(static_cast<int>(param.param.msm_beta * 100));
+                         });
+
+// The refinement is what removes the bias: with it off (eq. 14 alone) the soft object comes
+// out clearly softer than rendered, with it on within the tolerance (the test above).
+TEST(webcam_truth, WithoutRefinementTheFlowSmoothingBiasesMsmBetaUp) {
+  test::PressSceneConfig config;
+  config.msm_beta = 0.2;
+  config.noise_grey = 3;
+  const Tracked plain = track_scene(config, FlowMethod::dis, 0);
+  const double beta = estimated_beta(plain.result);
+  std::printf("msm_beta 0.2 without refinement: %.4f\n", beta);
+  EXPECT_GT(beta, config.msm_beta + kBetaTolerance);
+}
+
+// A larger scene at 64 px spacing, where DIS resolves the flow two pyramid levels down (32 px
+// patches in the frame, the setting of the 1920 x 1080 benchmark): eq. 14 alone gives about
+// 0.38 for a rendered 0.2 here; the refinement works at full resolution whatever the level.
+TEST(webcam_truth, CoarseFlowLevelIsRefinedAtFullResolution) {
+  test::PressSceneConfig config;
+  config.width = 640;
+  config.height = 400;
+  config.spacing_px = 64;
+  config.x0 = 96.5;
+  config.y0 = 100.5;
+  config.depth_px = 20;
+  config.msm_beta = 0.2;
+  const Tracked t = track_scene(config, FlowMethod::dis);
+  EXPECT_EQ(t.result.options.advection.dis_finest_scale, 2);
+  expect_press_roles(t);
+  const ErrorSummary e = summarize(t);
+  const double beta = estimated_beta(t.result);
+  std::printf("64 px spacing, DIS level 2: error median %.3f px, max %.3f px; msm_beta %.4f (rendered 0.2)\n", e.median,
+              e.max, beta);
+  EXPECT_LE(e.median, 0.5);
   EXPECT_NEAR(beta, config.msm_beta, kBetaTolerance);
 }
 

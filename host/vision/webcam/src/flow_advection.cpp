@@ -2,6 +2,8 @@
 #include <cmath>
 #include <string>
 
+#include <opencv2/video/tracking.hpp>
+
 #include "pliant/vision/webcam_advection.hpp"
 #include "pliant/vision/webcam_error.hpp"
 
@@ -36,6 +38,9 @@ void check_advection_config(const AdvectionConfig& c) {
     throw InputError("the template refresh similarity must be in [min similarity, 1]");
   }
   if (c.search_radius_px < 0 || c.search_radius_px > 50) throw InputError("--search-radius must be 0..50 px");
+  if (c.refine_window_px != 0 && (c.refine_window_px < 3 || c.refine_window_px > 51 || c.refine_window_px % 2 == 0)) {
+    throw InputError("--refine-window must be 0 (off) or odd, 3..51 px");
+  }
   if (c.dis_finest_scale < -1 || c.dis_finest_scale > 4) throw InputError("DIS finest scale must be 0..4 (or -1: from the spacing)");
 }
 
@@ -78,12 +83,17 @@ void FlowAdvector::observe(const cv::Mat& next, const std::vector<cv::Point2d>& 
     backward_.release();
   }
   out.assign(n, ParticleObservation{});
+  advected_.assign(n, cv::Point2d(ParticleObservation::kNaN, ParticleObservation::kNaN));
+  for (std::size_t i = 0; i < n; ++i) {
+    if (inside(previous_, positions[i])) advected_[i] = positions[i] + window_mean_flow(forward_, positions[i], config_.window_px);
+  }
+  if (config_.refine_window_px > 0) refine(positions);
   for (std::size_t i = 0; i < n; ++i) {
     ParticleObservation& o = out[i];
     const cv::Point2d p = positions[i];
     const cv::Point2d expected = std::isfinite(predicted[i].x) && std::isfinite(predicted[i].y) ? predicted[i] : p;
     cv::Point2d q = expected;
-    if (inside(previous_, p)) q = p + window_mean_flow(forward_, p, config_.window_px);
+    if (inside(previous_, p)) q = advected_[i];
     if (!inside(next_, q) && !inside(next_, expected)) {
       o.kind = ObservationKind::outside;
       continue;
@@ -120,6 +130,30 @@ void FlowAdvector::observe(const cv::Mat& next, const std::vector<cv::Point2d>& 
   }
   last_similarity_.resize(n);
   for (std::size_t i = 0; i < n; ++i) last_similarity_[i] = out[i].similarity;
+}
+
+void FlowAdvector::refine(const std::vector<cv::Point2d>& positions) {
+  from_.clear();
+  to_.clear();
+  index_.clear();
+  for (std::size_t i = 0; i < positions.size(); ++i) {
+    if (!inside(previous_, positions[i]) || !inside(next_, advected_[i])) continue;
+    from_.emplace_back(static_cast<float>(positions[i].x), static_cast<float>(positions[i].y));
+    to_.emplace_back(static_cast<float>(advected_[i].x), static_cast<float>(advected_[i].y));
+    index_.push_back(i);
+  }
+  if (from_.empty()) return;
+  const int w = config_.refine_window_px;
+  cv::calcOpticalFlowPyrLK(previous_, next_, from_, to_, lk_status_, lk_error_, cv::Size(w, w), 0,
+                           cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.001),
+                           cv::OPTFLOW_USE_INITIAL_FLOW);
+  for (std::size_t k = 0; k < index_.size(); ++k) {
+    const cv::Point2d refined(static_cast<double>(to_[k].x), static_cast<double>(to_[k].y));
+    const cv::Point2d d = refined - advected_[index_[k]];
+    if (lk_status_[k] != 0 && std::isfinite(d.x) && std::isfinite(d.y) && std::hypot(d.x, d.y) <= 0.5 * w) {
+      advected_[index_[k]] = refined;
+    }
+  }
 }
 
 void FlowAdvector::commit(const std::vector<cv::Point2d>& positions, const std::vector<std::uint8_t>& refresh) {

@@ -89,6 +89,7 @@ host::Recording track_recording(const TrackResult& result, const std::string& na
   track["rate_hz"] = result.rate_hz;
   track["flow"] = flow_method_name(o.flow);
   track["window_px"] = o.advection.window_px;
+  track["refine_window_px"] = o.advection.refine_window_px;
   track["forward_backward"] = o.advection.forward_backward;
   track["fb_threshold_px"] = o.advection.fb_threshold_px;
   track["min_similarity"] = o.advection.min_similarity;

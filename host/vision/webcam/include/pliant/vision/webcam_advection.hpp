@@ -3,6 +3,12 @@
 // Per frame pair (previous -> next) and particle i at p (its tracked position in previous):
 //   1. advect: q = p + o, o the flow averaged over a window_px x window_px window around p
 //      (the MSM paper's eq. 14, bilinear sub-pixel samples);
+//   1b. refine: q is refined by pyramid-free Lucas-Kanade (OpenCV calcOpticalFlowPyrLK, started
+//      at q) over a refine_window_px window at full resolution. Dense flow is regularised over
+//      its patches (DIS: 8 x 2^s px) and so flattens a sharp displacement peak such as the one
+//      under a tool, a bias that accumulates frame after frame and pushes msm_beta up; the small
+//      LK window follows the peak. A refinement that fails (LK status) or moves q by more than
+//      half its window keeps the eq. 14 position;
 //   2. forward-backward: the backward flow (next -> previous) averaged around q should bring q
 //      back to p; e = |q + o_back(q) - p| above fb_threshold_px marks the flow there unreliable
 //      (occlusion boundaries, flow errors);
@@ -47,6 +53,9 @@ struct AdvectionConfig {
   /// DIS pyramid level the flow is resolved at (0..4); -1: dis_finest_scale_for_spacing of the
   /// particle spacing (the tracking pipeline resolves it before constructing the advector).
   int dis_finest_scale = -1;
+  /// Side of the Lucas-Kanade window that refines each advected position at full resolution
+  /// (step 1b); 0 turns the refinement off (eq. 14 alone). Odd, 3..51 otherwise.
+  int refine_window_px = 9;
 };
 
 /// Throws InputError naming the first field out of range.
@@ -97,6 +106,7 @@ class FlowAdvector {
   const AdvectionConfig& config() const { return config_; }
 
  private:
+  void refine(const std::vector<cv::Point2d>& positions);
   PatchMatch search(const cv::Mat& templ, const cv::Point2d& a, const cv::Point2d& b) const;
 
   DenseFlow flow_;
@@ -104,6 +114,11 @@ class FlowAdvector {
   cv::Mat previous_, next_, forward_, backward_, patch_;
   std::vector<cv::Mat> templates_;
   std::vector<double> last_similarity_;
+  std::vector<cv::Point2d> advected_;          // eq. 14 positions, then refined
+  std::vector<cv::Point2f> from_, to_;         // calcOpticalFlowPyrLK's points
+  std::vector<std::size_t> index_;             // particle of each LK point
+  std::vector<unsigned char> lk_status_;
+  std::vector<float> lk_error_;
 };
 
 }  // namespace pliant::vision::webcam
