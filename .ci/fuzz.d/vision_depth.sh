@@ -1,7 +1,7 @@
 # Depth front end readers (tests/fuzz/vision/depth_fuzz.cpp): first byte 0 PNG (then the cloud),
 # 1 frame list, 2 intrinsics, 3 camera pose, 4 region. Built only when tests/fuzz/CMakeLists.txt
 # includes tests/fuzz/vision/depth.cmake. Seeds: a 4x3 16-bit PNG, the same cut short, a TUM list,
-# and one valid and one malformed text of each kind.
+# a `pliant record` depth_frames.csv, and one valid and one malformed text of each kind.
 if cmake --build "$build" --target help 2>/dev/null | grep 'vision_depth_fuzz' >/dev/null; then
   cmake --build "$build" --target vision_depth_fuzz -j "$(nproc)"
   depth_fuzzer="$build/bin/vision_depth_fuzz"
@@ -15,6 +15,9 @@ if cmake --build "$build" --target help 2>/dev/null | grep 'vision_depth_fuzz' >
   printf '\001# depth maps\n1305031102.160407 depth/1305031102.160407.png\r\n1305031102.194330\tdepth/2.png\n' \
     > "$depth_corpus/seed-list"
   printf '\0012 a.png\n1 b.png\n' > "$depth_corpus/seed-list-bad"
+  printf '\001index,t,file,depth_scale_m,fx,fy,cx,cy\n0,0.0334,depth/000000.png,0.001,570.3,570.3,319.5,239.5\r\n1,0.0667,depth/000001.png,0.001,nan,nan,nan,nan\n' \
+    > "$depth_corpus/seed-recorded-list"
+  printf '\001index,t,file,depth_scale_m,fx,fy,cx,cy\n0,0.1,a.png,-1,1,1,1\n' > "$depth_corpus/seed-recorded-list-bad"
   printf '\002517.3,516.5,318.6,255.3' > "$depth_corpus/seed-intrinsics"
   printf '\0020,1,2' > "$depth_corpus/seed-intrinsics-bad"
   printf '\0030.1,0.2,0.3,0,0,0.7071068,0.7071068' > "$depth_corpus/seed-pose"

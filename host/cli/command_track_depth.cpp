@@ -10,9 +10,10 @@
 #include <vector>
 
 #include "exit_status.hpp"
+#include "track_depth_input.hpp"
 #include "pliant/host/recording.hpp"
-#include "pliant/vision/depth_list.hpp"
 #include "pliant/vision/depth_recording.hpp"
+#include "pliant/vision/depth_seed.hpp"
 #include "pliant/vision/depth_text.hpp"
 
 namespace pliant::cli {
@@ -45,17 +46,31 @@ TrackDepthCommand::TrackDepthCommand(CLI::App& parent) {
   app_ = parent.add_subcommand("track-depth", "Track a depth image sequence into a 3D recording");
   app_->footer(
       "PLAN is a 3D recording in metres giving the particles' rest shape (its first frame or mesh), the fixed "
-      "support, the driven tool particle and its trajectory on the depth list's clock. DEPTH_LIST lists the "
-      "16-bit PNG depth frames as the TUM RGB-D benchmark does (lines 'timestamp filename', '#' comments; "
-      "names relative to the list). Writes a recording with one frame per depth frame; see docs/vision_depth.md. "
-      "Exit status: 0 ok, 1 runtime failure, 2 bad options or malformed input.");
-  app_->add_option("PLAN", plan_, "Plan recording directory (docs/spec/recording-v1.md)")->required();
-  app_->add_option("DEPTH_LIST", depth_list_, "Depth frame list (TUM depth.txt format)")->required();
+      "support, the driven tool particle and its trajectory on the depth frames' clock; without one, "
+      "--seed-spacing seeds particles on the first frame's surface. DEPTH is a list of 16-bit PNG depth frames "
+      "(TUM RGB-D depth.txt: 'timestamp filename' lines; or the depth_frames.csv of `pliant record`, which "
+      "also gives the scale and intrinsics) or an OpenNI .oni recording. Writes a recording with one frame per "
+      "depth frame; see docs/vision_depth.md. Exit status: 0 ok, 1 runtime failure, 2 bad options or malformed "
+      "input.");
+  // Two positionals, the first optional: CLI11 would give a lone argument to the first, so both
+  // are taken as one list and split in run().
+  app_->add_option("PLAN_DEPTH", positionals_,
+                   "[PLAN] DEPTH: the plan recording directory (docs/spec/recording-v1.md; omitted with "
+                   "--seed-spacing), then the depth frames (TUM list, pliant record depth_frames.csv, or .oni)")
+      ->expected(1, 2)
+      ->required();
+  app_->add_option("--seed-spacing", seed_spacing_m_,
+                   "No plan: seed one particle per cube of this edge (m) on the first frame's surface (crop with "
+                   "--region and --min-depth/--max-depth); no support, no tool")
+      ->type_name("M");
   app_->add_option("-o,--output", output_, "Recording directory to write (created if missing)")
       ->type_name("DIR")
       ->required();
-  app_->add_option("--intrinsics", intrinsics_, "Depth camera intrinsics in pixels")->type_name("FX,FY,CX,CY")->required();
-  app_->add_option("--units-per-metre", units_per_metre_, "Raw depth units per metre (1000: millimetres; TUM: 5000)")
+  app_->add_option("--intrinsics", intrinsics_,
+                   "Depth camera intrinsics in pixels (default: those depth_frames.csv or the .oni states)")
+      ->type_name("FX,FY,CX,CY");
+  app_->add_option("--units-per-metre", units_per_metre_,
+                   "Raw depth units per metre (1000: millimetres; TUM: 5000; default: the input's scale, else 1000)")
       ->type_name("U")
       ->capture_default_str();
   app_->add_option("--camera-pose", camera_pose_,
@@ -106,23 +121,44 @@ int TrackDepthCommand::run() const {
   if (reference_frames_ < 0) throw UsageError("--reference-frames must be >= 0");
   if (!std::isfinite(time_offset_s_)) throw UsageError("--time-offset must be finite");
   if (correspondence_ != "plane" && correspondence_ != "point") throw UsageError("--correspondence must be plane or point");
+  const std::string plan_ = positionals_.size() == 2 ? positionals_.front() : std::string();
+  const std::string depth_list_ = positionals_.back();
+  const bool seeding = app_->count("--seed-spacing") > 0;
+  if (seeding && !(std::isfinite(seed_spacing_m_) && seed_spacing_m_ > 0)) throw UsageError("--seed-spacing must be > 0 m");
+  if (seeding && !plan_.empty()) throw UsageError("give either PLAN or --seed-spacing, not both");
+  if (!seeding && plan_.empty()) throw UsageError("give PLAN (a recording of the particles) or --seed-spacing M");
   check_output_directory(output_, force_);
 
-  const host::Recording plan = host::read_recording(plan_);
-  for (const std::string& warning : plan.warnings) report_warning(warning);
+  host::Recording plan;
+  if (!seeding) {
+    plan = host::read_recording(plan_);
+    for (const std::string& warning : plan.warnings) report_warning(warning);
+  }
 
   try {
-    const std::vector<vision::DepthListEntry> list = vision::read_depth_list(depth_list_);
-    vision::DepthImage current = vision::read_depth_png(list.front().path);
-    int current_index = 0;
-    const vision::PinholeIntrinsics intrinsics = vision::parse_intrinsics(intrinsics_, current.width, current.height);
+    const std::unique_ptr<DepthInput> input = open_depth_input(depth_list_);
+    const vision::DepthImageView first = input->frame(0);
+    vision::PinholeIntrinsics intrinsics;
+    if (!intrinsics_.empty()) {
+      intrinsics = vision::parse_intrinsics(intrinsics_, first.width, first.height);
+    } else if (std::isfinite(input->fx) && std::isfinite(input->fy) && std::isfinite(input->cx) &&
+               std::isfinite(input->cy)) {
+      intrinsics = vision::parse_intrinsics(number(input->fx, "%.17g") + "," + number(input->fy, "%.17g") + "," +
+                                                number(input->cx, "%.17g") + "," + number(input->cy, "%.17g"),
+                                            first.width, first.height);
+    } else {
+      throw UsageError(depth_list_ + ": the " + input->kind + " states no intrinsics; give --intrinsics FX,FY,CX,CY");
+    }
+    const bool scale_given = app_->count("--units-per-metre") > 0;
+    const double depth_scale_m =
+        !scale_given && std::isfinite(input->depth_scale_m) ? input->depth_scale_m : 1.0 / units_per_metre_;
 
     vision::DepthSequenceOptions options;
     options.msm_beta = msm_beta_;
     options.observed_only = !all_tracked_;
     options.reference_frames = reference_frames_;
     vision::DepthTrackerConfig& config = options.tracker;
-    config.cloud.depth_scale_m = 1.0 / units_per_metre_;
+    config.cloud.depth_scale_m = depth_scale_m;
     config.cloud.stride = stride_;
     config.cloud.min_depth_m = min_depth_m_;
     config.cloud.max_depth_m = max_depth_m_ > 0 ? max_depth_m_ : std::numeric_limits<double>::infinity();
@@ -133,15 +169,21 @@ int TrackDepthCommand::run() const {
     config.depth_noise_m = noise_m_;
 
     std::vector<double> times;
-    for (const vision::DepthListEntry& entry : list) times.push_back(entry.t_s + time_offset_s_);
-    // Frames are read when asked for; the one in memory is kept (frame 0 is asked for first).
-    const vision::DepthFrameSource frames = [&](int index) {
-      if (index != current_index) {
-        current = vision::read_depth_png(list[static_cast<std::size_t>(index)].path);
-        current_index = index;
-      }
-      return current.view();
-    };
+    for (const double t : input->times_s()) times.push_back(t + time_offset_s_);
+    const vision::DepthFrameSource frames = [&](int index) { return input->frame(index); };
+
+    if (seeding) {
+      // One particle per voxel of the first frame's cloud (cropped by the region and depth
+      // range): a one-layer shell with the cloud's normals, clusters of nearest neighbours.
+      vision::DepthCloud cloud;
+      vision::depth_to_cloud(input->frame(0), intrinsics, config.cloud, cloud);
+      const vision::SeededParticles seeds = vision::seed_particles(cloud, seed_spacing_m_, config.camera_to_world);
+      plan = vision::seeded_plan(seeds, times.front());
+      options.rest_normals = seeds.normals;
+      options.setup.clusters.layout = ClusterLayout::k_nearest;
+      std::cout << "seeded " << plan.particle_count << " particles " << number(1e3 * seed_spacing_m_) << " mm apart on "
+                << cloud.points.size() << " points of the first frame\n";
+    }
 
     vision::DepthSequenceResult result;
     std::vector<double> priors, estimates;
@@ -167,6 +209,8 @@ int TrackDepthCommand::run() const {
     const auto& a = result.alignment;
     const int lookable = plan.particle_count - a.by_view[static_cast<std::size_t>(vision::ParticleView::held)] -
                          a.by_view[static_cast<std::size_t>(vision::ParticleView::interior)];
+    std::cout << "read " << times.size() << " frames (" << input->kind << "), " << first.width << "x" << first.height
+              << ", " << number(depth_scale_m * 1e3) << " mm per unit\n";
     std::cout << "wrote " << output_ << ": " << plan.particle_count << " particles x " << times.size() << " frames ("
               << (options.observed_only ? "observed positions only" : "every tracked position") << ")\n";
     std::cout << "first frame: " << a.observed << " of " << lookable

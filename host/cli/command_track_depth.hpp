@@ -1,8 +1,9 @@
-// `pliant track-depth PLAN DEPTH_LIST -o DIR`: a depth image sequence tracked into a 3D
-// recording (host/vision/depth, docs/vision_depth.md).
+// `pliant track-depth PLAN DEPTH -o DIR` (or `--seed-spacing M DEPTH` without a plan): a depth
+// image sequence (TUM list, `pliant record` depth_frames.csv, .oni) tracked into a 3D recording (host/vision/depth, docs/vision_depth.md).
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -19,8 +20,7 @@ class TrackDepthCommand {
 
  private:
   CLI::App* app_ = nullptr;
-  std::string plan_;
-  std::string depth_list_;
+  std::vector<std::string> positionals_;  // [PLAN] DEPTH
   std::string output_;
   std::string intrinsics_;
   std::string camera_pose_;
@@ -33,6 +33,7 @@ class TrackDepthCommand {
   double noise_m_ = 1e-3;
   double msm_beta_ = 0.5;
   double time_offset_s_ = 0.0;
+  double seed_spacing_m_ = 0.0;
   int rounds_ = 1;
   int reference_frames_ = 15;
   bool all_tracked_ = false;

@@ -66,6 +66,11 @@ void list(std::string_view text) {
     for (std::size_t i = 0; i < entries.size(); ++i) {
       check(std::isfinite(entries[i].t_s) && !entries[i].path.empty());
       if (i > 0) check(entries[i].t_s > entries[i - 1].t_s);
+      // depth_frames.csv rows carry a positive scale, TUM rows none; intrinsics number or NaN.
+      const DepthListEntry& e = entries[i];
+      check(std::isnan(e.depth_scale_m) == std::isnan(entries[0].depth_scale_m));
+      check(std::isnan(e.depth_scale_m) || (std::isfinite(e.depth_scale_m) && e.depth_scale_m > 0));
+      check(!std::isinf(e.fx) && !std::isinf(e.fy) && !std::isinf(e.cx) && !std::isinf(e.cy));
     }
   } catch (const DepthError& error) {
     one_line(error);

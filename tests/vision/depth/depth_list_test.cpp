@@ -1,6 +1,8 @@
-// TUM-style depth frame lists: the format as the benchmark writes it, and every malformed line.
+// Depth frame lists: the TUM format as the benchmark writes it, `pliant record`'s depth_frames.csv,
+// and every malformed line of each.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -57,6 +59,58 @@ TEST(DepthList, MalformedLinesAreNamed) {
   const std::string message = error_of(std::string(200, 'x') + " a.png\n");
   EXPECT_LT(message.size(), 100u);
   EXPECT_NE(message.find("..."), std::string::npos);
+}
+
+constexpr const char* kRecordedHeader = "index,t,file,depth_scale_m,fx,fy,cx,cy\n";
+
+TEST(DepthList, ReadsTheRecordersDepthFrames) {
+  const std::string text = std::string(kRecordedHeader) +
+                           "0,0.0334,depth/000000.png,0.001,570.34,570.34,319.5,239.5\r\n"
+                           "\n"
+                           "1,0.0667,depth/000001.png,0.0001,nan,nan,nan,nan\n";
+  const std::vector<DepthListEntry> list = parse_depth_list(text, "depth_frames.csv");
+  ASSERT_EQ(list.size(), 2u);
+  EXPECT_DOUBLE_EQ(list[0].t_s, 0.0334);
+  EXPECT_EQ(list[0].path, "depth/000000.png");
+  EXPECT_DOUBLE_EQ(list[0].depth_scale_m, 0.001);
+  EXPECT_DOUBLE_EQ(list[0].fx, 570.34);
+  EXPECT_DOUBLE_EQ(list[0].cy, 239.5);
+  EXPECT_DOUBLE_EQ(list[1].depth_scale_m, 1e-4);
+  EXPECT_TRUE(std::isnan(list[1].fx) && std::isnan(list[1].fy) && std::isnan(list[1].cx) && std::isnan(list[1].cy));
+  // A TUM list leaves them unknown.
+  const std::vector<DepthListEntry> tum = parse_depth_list("0.5 a.png\n", "depth.txt");
+  EXPECT_TRUE(std::isnan(tum[0].depth_scale_m) && std::isnan(tum[0].fx));
+}
+
+TEST(DepthList, MalformedRecordedRowsAreNamed) {
+  auto error = [](const std::string& rows) {
+    try {
+      parse_depth_list(std::string(kRecordedHeader) + rows, "depth_frames.csv");
+    } catch (const DepthError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(error("0,0.1,a.png,0.001,1,1,1\n"),
+            "depth_frames.csv:2: expected 8 fields (index,t,file,depth_scale_m,fx,fy,cx,cy), found 7");
+  EXPECT_EQ(error("0,0.1,a.png,0.001,1,1,1,1,1\n"),
+            "depth_frames.csv:2: expected 8 fields (index,t,file,depth_scale_m,fx,fy,cx,cy), found 9");
+  EXPECT_EQ(error("x,0.1,a.png,0.001,1,1,1,1\n"), "depth_frames.csv:2: index 'x' is not a whole number");
+  EXPECT_EQ(error("1.5,0.1,a.png,0.001,1,1,1,1\n"), "depth_frames.csv:2: index '1.5' is not a whole number");
+  EXPECT_EQ(error("-1,0.1,a.png,0.001,1,1,1,1\n"), "depth_frames.csv:2: index '-1' is not a whole number");
+  EXPECT_EQ(error("0,nan,a.png,0.001,1,1,1,1\n"), "depth_frames.csv:2: timestamp 'nan' is not a number");
+  EXPECT_EQ(error("0,,a.png,0.001,1,1,1,1\n"), "depth_frames.csv:2: timestamp '' is not a number");
+  EXPECT_EQ(error("0,0.2,a.png,0.001,1,1,1,1\n1,0.2,b.png,0.001,1,1,1,1\n"),
+            "depth_frames.csv:3: timestamp '0.2' does not follow the previous one");
+  EXPECT_EQ(error("0,0.1,,0.001,1,1,1,1\n"), "depth_frames.csv:2: empty file name");
+  EXPECT_EQ(error(std::string("0,0.1,a\x02.png,0.001,1,1,1,1\n")),
+            "depth_frames.csv:2: control character in file name 'a\\x02.png'");
+  EXPECT_EQ(error("0,0.1,a.png,0,1,1,1,1\n"), "depth_frames.csv:2: depth_scale_m '0' is not a positive number");
+  EXPECT_EQ(error("0,0.1,a.png,nan,1,1,1,1\n"), "depth_frames.csv:2: depth_scale_m 'nan' is not a positive number");
+  EXPECT_EQ(error("0,0.1,a.png,0.001,1,one,1,1\n"), "depth_frames.csv:2: fy 'one' is neither a number nor nan");
+  EXPECT_EQ(error("0,0.1,a.png,0.001,1,1,1, 1\n"), "depth_frames.csv:2: cy ' 1' is neither a number nor nan");
+  EXPECT_EQ(error(""), "depth_frames.csv: no depth frame listed");
+  EXPECT_EQ(error("\n\r\n"), "depth_frames.csv: no depth frame listed");
 }
 
 TEST(DepthList, RelativeNamesAreBesideTheList) {
