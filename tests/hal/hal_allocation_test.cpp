@@ -10,6 +10,7 @@
 #include "hal_fixture.hpp"
 #include "pliant/hal/guard_inputs.hpp"
 #include "pliant/hal/mock/fault_script.hpp"
+#include "pliant/hal/mock/faulty_cameras.hpp"
 #include "pliant/hal/mock/mock_cameras.hpp"
 #include "pliant/hal/mock/replay_devices.hpp"
 #include "pliant/hal/stream_monitor.hpp"
@@ -80,6 +81,51 @@ TEST(HalAllocation, DeviceCyclesAllocateNothing) {
   EXPECT_GT(delivered, 40);
   EXPECT_GT(plant.counters().msm_steps, 1000u);
   EXPECT_GT(gripper.fault_counters().total() + ft.fault_counters().total() + observer.fault_counters().total(), 0u);
+}
+
+// The fault wrappers of real cameras (here around fault-free mocks): every sample fault kind,
+// with the frame copies the freeze kinds need.
+TEST(HalAllocation, FaultyCameraReadsAllocateNothing) {
+  test::SteppedClock t;
+  MockColorCamera color_inner(t.clock);
+  MockDepthCamera depth_inner(t.clock);
+  FaultyColorCamera color(color_inner, t.clock, 64 * 48 * 3);
+  FaultyDepthCamera depth(depth_inner, t.clock, 64 * 48 * 2);
+  const std::string script =
+      "1.02 drop color 0.02\n1.05 freeze_data color 0.05\n1.12 freeze_stamp color 0.05\n1.2 disconnect color 0.05\n"
+      "1.02 nan depth 0.05\n1.1 freeze_data depth 0.05\n1.17 stamp_jump depth 0.05\n1.25 fault_bits depth 0.05\n"
+      "1.3 timeout depth 0.02\n";
+  FaultScript faults;
+  FaultScriptError error;
+  ASSERT_EQ(parse_fault_script(script.data(), script.size(), faults, error), HalStatus::ok) << error.message;
+  ASSERT_EQ(color.set_fault_schedule(faults.of(FaultDevice::color_camera)), HalStatus::ok);
+  ASSERT_EQ(depth.set_fault_schedule(faults.of(FaultDevice::depth_camera)), HalStatus::ok);
+  ASSERT_EQ(color.configure(), HalStatus::ok);
+  ASSERT_EQ(depth.configure(), HalStatus::ok);
+  ASSERT_EQ(color.start(), HalStatus::ok);
+  ASSERT_EQ(depth.start(), HalStatus::ok);
+  ColorFrame c;
+  DepthFrame d;
+  long delivered = 0;
+  AllocationCounts counts;
+  {
+    AllocationCounter counter;
+    for (int k = 0; k < 400; ++k) {
+      t.step();
+      delivered += color.read(c) == HalStatus::ok ? 1 : 0;
+      delivered += depth.read(d) == HalStatus::ok ? 1 : 0;
+    }
+    counts = counter.stop();
+  }
+  EXPECT_EQ(counts.total(), 0u) << "news=" << counts.news << " mallocs=" << counts.mallocs;
+  EXPECT_GT(delivered, 10);
+  for (FaultKind kind : {FaultKind::drop, FaultKind::freeze_data, FaultKind::freeze_stamp, FaultKind::disconnect}) {
+    EXPECT_GT(color.fault_counters().of(kind), 0u) << fault_kind_name(kind);
+  }
+  for (FaultKind kind : {FaultKind::nan, FaultKind::freeze_data, FaultKind::stamp_jump, FaultKind::fault_bits,
+                         FaultKind::timeout}) {
+    EXPECT_GT(depth.fault_counters().of(kind), 0u) << fault_kind_name(kind);
+  }
 }
 
 TEST(HalAllocation, ReplayReadsAllocateNothing) {

@@ -13,6 +13,8 @@
 
 #include "oni_test_support.hpp"
 #include "pliant/drivers/openni2/openni2_camera.hpp"
+#include "pliant/hal/mock/fault_script.hpp"
+#include "pliant/hal/mock/faulty_cameras.hpp"
 #include "pliant/hal/clock.hpp"
 #include "support/temp_dir.hpp"
 
@@ -102,6 +104,66 @@ TEST(Openni2Recording, StepsThroughAllTwelveFrames) {
   EXPECT_EQ(camera.counters().samples, 12u);
   EXPECT_EQ(camera.counters().dropped, 0u);
   EXPECT_EQ(camera.counters().no_data, 2u);
+  EXPECT_EQ(camera.stop(), HalStatus::ok);
+  EXPECT_EQ(camera.cleanup(), HalStatus::ok);
+}
+
+// The .oni played through hal's FaultyDepthCamera with a fault script: the media replay with
+// scripted faults that hardware-in-the-loop tests use. Stepped stamps start at 100 s and advance
+// 33.4 ms per frame (frame k at ~100 + 0.0334 (k - 1)): frame 2 dropped, frame 4 all zero,
+// frame 6 frozen on frame 5's pixels; the read made while the clock is at 200 is disconnected.
+TEST(Openni2Recording, PlaysThroughScriptedFaults) {
+  pliant::hal::ManualClock clock(100);
+  Openni2Camera player(clock, recording_config(oni::fixture_path()));
+  pliant::hal::FaultyDepthCamera camera(player, clock, 640 * 480 * 2);
+  const std::string text =
+      "100.02 drop depth 0.03\n"
+      "100.09 nan depth 0.02\n"
+      "100.155 freeze_data depth 0.02\n"
+      "200 disconnect depth 1\n";
+  pliant::hal::FaultScript script;
+  pliant::hal::FaultScriptError error;
+  ASSERT_EQ(pliant::hal::parse_fault_script(text.data(), text.size(), script, error), HalStatus::ok) << error.message;
+  ASSERT_EQ(camera.set_fault_schedule(script.of(pliant::hal::FaultDevice::depth_camera)), HalStatus::ok);
+  ASSERT_EQ(camera.configure(), HalStatus::ok) << player.last_error();
+  ASSERT_EQ(camera.start(), HalStatus::ok);
+  std::vector<std::uint16_t> fifth;
+  int delivered = 0, zero_frames = 0;
+  for (int k = 1; k <= 12; ++k) {
+    DepthFrame frame;
+    const HalStatus status = camera.read(frame);
+    if (k == 2) {
+      EXPECT_EQ(status, HalStatus::no_data);
+      continue;
+    }
+    ASSERT_EQ(status, HalStatus::ok) << "frame " << k;
+    ++delivered;
+    EXPECT_EQ(frame.header.sequence, static_cast<std::uint64_t>(k));
+    const std::vector<std::uint16_t> pixels(frame.data, frame.data + 640 * 480);
+    double valid = 0;
+    median_depth_m(frame, &valid);
+    if (k == 4) {
+      EXPECT_EQ(valid, 0.0);
+      ++zero_frames;
+    } else {
+      EXPECT_GT(valid, 0.5) << "frame " << k;
+    }
+    if (k == 5) fifth = pixels;
+    if (k == 6) {
+      EXPECT_EQ(pixels, fifth) << "frozen on frame 5";
+    }
+  }
+  EXPECT_EQ(delivered, 11);
+  EXPECT_EQ(zero_frames, 1);
+  ASSERT_EQ(clock.set(200.5), HalStatus::ok);
+  DepthFrame frame;
+  EXPECT_EQ(camera.read(frame), HalStatus::disconnected);
+  EXPECT_EQ(camera.counters().dropped, 1u);
+  EXPECT_EQ(camera.counters().disconnected, 1u);
+  EXPECT_EQ(camera.fault_counters().of(pliant::hal::FaultKind::drop), 1u);
+  EXPECT_EQ(camera.fault_counters().of(pliant::hal::FaultKind::nan), 1u);
+  EXPECT_EQ(camera.fault_counters().of(pliant::hal::FaultKind::freeze_data), 1u);
+  EXPECT_EQ(player.counters().samples, 12u);  // the player delivered every frame
   EXPECT_EQ(camera.stop(), HalStatus::ok);
   EXPECT_EQ(camera.cleanup(), HalStatus::ok);
 }
