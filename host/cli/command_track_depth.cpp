@@ -121,22 +121,22 @@ int TrackDepthCommand::run() const {
   if (reference_frames_ < 0) throw UsageError("--reference-frames must be >= 0");
   if (!std::isfinite(time_offset_s_)) throw UsageError("--time-offset must be finite");
   if (correspondence_ != "plane" && correspondence_ != "point") throw UsageError("--correspondence must be plane or point");
-  const std::string plan_ = positionals_.size() == 2 ? positionals_.front() : std::string();
-  const std::string depth_list_ = positionals_.back();
+  const std::string plan_dir = positionals_.size() == 2 ? positionals_.front() : std::string();
+  const std::string depth_path = positionals_.back();
   const bool seeding = app_->count("--seed-spacing") > 0;
   if (seeding && !(std::isfinite(seed_spacing_m_) && seed_spacing_m_ > 0)) throw UsageError("--seed-spacing must be > 0 m");
-  if (seeding && !plan_.empty()) throw UsageError("give either PLAN or --seed-spacing, not both");
-  if (!seeding && plan_.empty()) throw UsageError("give PLAN (a recording of the particles) or --seed-spacing M");
+  if (seeding && !plan_dir.empty()) throw UsageError("give either PLAN or --seed-spacing, not both");
+  if (!seeding && plan_dir.empty()) throw UsageError("give PLAN (a recording of the particles) or --seed-spacing M");
   check_output_directory(output_, force_);
 
   host::Recording plan;
   if (!seeding) {
-    plan = host::read_recording(plan_);
+    plan = host::read_recording(plan_dir);
     for (const std::string& warning : plan.warnings) report_warning(warning);
   }
 
   try {
-    const std::unique_ptr<DepthInput> input = open_depth_input(depth_list_);
+    const std::unique_ptr<DepthInput> input = open_depth_input(depth_path);
     const vision::DepthImageView first = input->frame(0);
     vision::PinholeIntrinsics intrinsics;
     if (!intrinsics_.empty()) {
@@ -147,7 +147,7 @@ int TrackDepthCommand::run() const {
                                                 number(input->cx, "%.17g") + "," + number(input->cy, "%.17g"),
                                             first.width, first.height);
     } else {
-      throw UsageError(depth_list_ + ": the " + input->kind + " states no intrinsics; give --intrinsics FX,FY,CX,CY");
+      throw UsageError(depth_path + ": the " + input->kind + " states no intrinsics; give --intrinsics FX,FY,CX,CY");
     }
     const bool scale_given = app_->count("--units-per-metre") > 0;
     const double depth_scale_m =
