@@ -181,17 +181,17 @@ struct PressRecording {
 };
 
 struct PressPlan {
-  std::vector<int> extents;    // x, y[, z]
+  std::vector<int> extents;  // x, y[, z]
   double spacing = 1;
   double x0 = 0, y0 = 0;
-  double y_step_sign = 1;      // 2D image plane: rows go up the image, y decreases
+  double y_step_sign = 1;  // 2D image plane: rows go up the image, y decreases
   int tool = 0;
-  std::vector<double> press;   // tool displacement at full depth (Dim entries)
+  std::vector<double> press;  // tool displacement at full depth (Dim entries)
   double ramp_s = 1;
   double duration_s = 4;
   double rate_hz = 30;
   double msm_beta = 0.5;
-  double noise = 0.005;        // position noise std, fraction of the spacing
+  double noise = 0.005;  // position noise std, fraction of the spacing
   std::uint64_t seed = 1;
 };
 
@@ -243,8 +243,8 @@ inline PressPlan block_press_plan() {
 template <int Dim, typename Scalar>
 void simulate_press(const PressPlan& plan, PressRecording<Dim, Scalar>& out) {
   using VecD = Eigen::Matrix<double, Dim, 1>;
-  const std::vector<double> truth_rest = lattice<Dim, double>(plan.extents, plan.spacing, plan.x0, plan.y0,
-                                                               plan.y_step_sign);
+  const std::vector<double> truth_rest =
+      lattice<Dim, double>(plan.extents, plan.spacing, plan.x0, plan.y0, plan.y_step_sign);
   const int n = static_cast<int>(truth_rest.size() / Dim);
   out.particle_count = n;
   out.tool = plan.tool;
@@ -271,8 +271,8 @@ void simulate_press(const PressPlan& plan, PressRecording<Dim, Scalar>& out) {
     for (int i = 0; i < n; ++i) {
       for (int d = 0; d < Dim; ++d) {
         constexpr std::uint64_t kPrime = 1000003;
-        const std::uint64_t key = (plan.seed * kPrime + static_cast<std::uint64_t>(frame)) * kPrime +
-                                  static_cast<std::uint64_t>(i * Dim + d);
+        const std::uint64_t key =
+            (plan.seed * kPrime + static_cast<std::uint64_t>(frame)) * kPrime + static_cast<std::uint64_t>(i * Dim + d);
         out.positions.push_back(static_cast<Scalar>(truth.state.position[i](d) + sigma * unit_noise(key)));
       }
     }
@@ -328,8 +328,8 @@ class BudgetReporter : public benchmark::ConsoleReporter {
       const auto found = budgets_.find(run.run_name.str());
       if (found == budgets_.end()) continue;
       const double to_us = 1e6 / benchmark::GetTimeUnitMultiplier(run.time_unit);
-      verdicts_.push_back({run.benchmark_name(), run.GetAdjustedCPUTime() * to_us, run.GetAdjustedRealTime() * to_us,
-                           found->second});
+      verdicts_.push_back(
+          {run.benchmark_name(), run.GetAdjustedCPUTime() * to_us, run.GetAdjustedRealTime() * to_us, found->second});
     }
   }
 
@@ -342,8 +342,8 @@ class BudgetReporter : public benchmark::ConsoleReporter {
     out << "\nBudgets (per iteration; verdict on CPU time):\n";
     char line[320];
     for (const Verdict& v : verdicts_) {
-      std::snprintf(line, sizeof line, "  %-50s cpu %10.3f us  real %10.3f us  budget %8.1f us  %s\n",
-                    v.name.c_str(), v.cpu_us, v.real_us, v.budget_us, v.cpu_us <= v.budget_us ? "ok" : "MISSED");
+      std::snprintf(line, sizeof line, "  %-50s cpu %10.3f us  real %10.3f us  budget %8.1f us  %s\n", v.name.c_str(),
+                    v.cpu_us, v.real_us, v.budget_us, v.cpu_us <= v.budget_us ? "ok" : "MISSED");
       out << line;
     }
   }
@@ -391,7 +391,8 @@ inline int run_benchmarks(int argc, char** argv, const Budgets& budgets) {
 #if defined(__OPTIMIZE__)
   benchmark::AddCustomContext("pliant_optimized", "yes");
 #else
-  benchmark::AddCustomContext("pliant_optimized", "NO: numbers are not representative, build with -DCMAKE_BUILD_TYPE=Release");
+  benchmark::AddCustomContext("pliant_optimized",
+                              "NO: numbers are not representative, build with -DCMAKE_BUILD_TYPE=Release");
 #endif
   if (!console) {
     benchmark::RunSpecifiedBenchmarks();

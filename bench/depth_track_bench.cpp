@@ -124,7 +124,8 @@ int run(int argc, char** argv) {
   const int n = r.particle_count;
   frame_count = std::min(frame_count, r.frame_count());
   const Eigen::Vector3d centre(0.045, 0.045, 0.045);
-  const Eigen::Isometry3d camera = vision::test::look_at(centre + Eigen::Vector3d(0.24, -0.335, 0.365), centre, {0, 0, 1});
+  const Eigen::Isometry3d camera =
+      vision::test::look_at(centre + Eigen::Vector3d(0.24, -0.335, 0.365), centre, {0, 0, 1});
   vision::test::DepthRenderer renderer(k, camera);
   // Region: the block's rest box (with the lower part of the tool) projected, padded 10 px.
   double u0 = 1e9, v0 = 1e9, u1 = -1e9, v1 = -1e9;
@@ -170,7 +171,9 @@ int run(int argc, char** argv) {
   CloudAdaptor adaptor{&cloud.points};
   using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, CloudAdaptor>, CloudAdaptor, 3,
                                                    std::uint32_t>;
-  Tree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16, nanoflann::KDTreeSingleIndexAdaptorFlags::SkipInitialBuildIndex));
+  Tree tree(
+      3, adaptor,
+      nanoflann::KDTreeSingleIndexAdaptorParams(16, nanoflann::KDTreeSingleIndexAdaptorFlags::SkipInitialBuildIndex));
   for (int f = 1; f < frame_count; ++f) {
     vision::driven_targets_at(plan, r.frame_times_s[static_cast<std::size_t>(f)], ids, targets);
     const MsmDrivenTargets<3, double> driven{ids.data(), targets.data(), static_cast<int>(ids.size())};
@@ -183,10 +186,11 @@ int run(int argc, char** argv) {
     build.run([&] { tree.buildIndex(); });
   }
   const double frames_timed = static_cast<double>(frame_count - 1);
-  std::printf("\n2. DepthTracker::update: %d particles, %.0f points per frame (region %dx%d), %.0f particles observed "
-              "per frame, %d frames\n",
-              n, static_cast<double>(points) / frames_timed, config.cloud.region.width, config.cloud.region.height,
-              static_cast<double>(observed) / frames_timed, frame_count - 1);
+  std::printf(
+      "\n2. DepthTracker::update: %d particles, %.0f points per frame (region %dx%d), %.0f particles observed "
+      "per frame, %d frames\n",
+      n, static_cast<double>(points) / frames_timed, config.cloud.region.width, config.cloud.region.height,
+      static_cast<double>(observed) / frames_timed, frame_count - 1);
   print("update (whole frame)", update);
   print("  of which: cloud conversion", convert);
   print("  of which: nanoflann kd-tree build", build);

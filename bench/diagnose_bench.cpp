@@ -58,8 +58,8 @@ const std::vector<std::string> kShortLabels = {"none", "plast", "visc", "frict",
 struct Timed {
   DiagnoseResult result;
   double wall_s = 0;
-  double cpu_s = 0;     // process CPU time (diagnose is single-threaded)
-  std::string error;    // what() when diagnose_recording threw
+  double cpu_s = 0;   // process CPU time (diagnose is single-threaded)
+  std::string error;  // what() when diagnose_recording threw
 };
 
 Timed timed_diagnose(const Recording& recording) {
@@ -138,8 +138,8 @@ void concealed_suite(const fs::path& suite) {
     std::printf("  no case_* directory with a recording.json; section skipped\n\n");
     return;
   }
-  std::printf("  %-8s %-16s %-13s %9s  %-15s %-13s %7s %8s %8s  %s\n", "case", "scenario", "truth",
-              "rms/noise", "verdict", "found", "improv", "wall s", "cpu s", "pass");
+  std::printf("  %-8s %-16s %-13s %9s  %-15s %-13s %7s %8s %8s  %s\n", "case", "scenario", "truth", "rms/noise",
+              "verdict", "found", "improv", "wall s", "cpu s", "pass");
   Confusion confusion;
   int passed = 0, none_cases = 0, false_alarms = 0, effect_cases = 0, named_right = 0;
   double wall_total = 0, cpu_total = 0, wall_max = 0;
@@ -157,8 +157,7 @@ void concealed_suite(const fs::path& suite) {
     const std::string found = found_label(timed);
     const auto& d = timed.result.diagnosis;
     // The acceptance test's criterion (tests/host/concealed_suite_test.cpp).
-    const bool pass = effect == "none" ? found == "none"
-                                       : (found == effect && d.improvement >= 0.5);
+    const bool pass = effect == "none" ? found == "none" : (found == effect && d.improvement >= 0.5);
     confusion.add(effect, found);
     passed += pass ? 1 : 0;
     if (effect == "none") {
@@ -174,9 +173,8 @@ void concealed_suite(const fs::path& suite) {
     std::printf("  %-8s %-16s %-13s %9s  %-15s %-13s %7.3f %8.2f %8.2f  %s%s%s\n", name.c_str(),
                 truth.is_object() ? truth.value("scenario", "?").c_str() : "?", effect.c_str(),
                 size_text(truth.is_object() ? rms_over_noise(truth) : -1).c_str(),
-                timed.error.empty() ? d.verdict.c_str() : "error", d.effect.c_str(), d.improvement,
-                timed.wall_s, timed.cpu_s, pass ? "yes" : "NO",
-                timed.error.empty() ? "" : "  error: ", timed.error.c_str());
+                timed.error.empty() ? d.verdict.c_str() : "error", d.effect.c_str(), d.improvement, timed.wall_s,
+                timed.cpu_s, pass ? "yes" : "NO", timed.error.empty() ? "" : "  error: ", timed.error.c_str());
     std::fflush(stdout);
   }
   std::printf("\n  Confusion matrix (rows: truth, columns: found; none = consistent verdict):\n");
@@ -185,8 +183,8 @@ void concealed_suite(const fs::path& suite) {
   std::printf("  Effect named right: %d / %d effect cases\n", named_right, effect_cases);
   std::printf("  False alarms: %d / %d no-effect cases (%.0f %%)\n", false_alarms, none_cases,
               none_cases > 0 ? 100.0 * false_alarms / none_cases : 0.0);
-  std::printf("  Runtime: total %.1f s wall (%.1f s CPU), per case mean %.2f s, max %.2f s wall\n\n",
-              wall_total, cpu_total, wall_total / static_cast<double>(cases.size()), wall_max);
+  std::printf("  Runtime: total %.1f s wall (%.1f s CPU), per case mean %.2f s, max %.2f s wall\n\n", wall_total,
+              cpu_total, wall_total / static_cast<double>(cases.size()), wall_max);
 }
 
 // ---- b. detection against effect size -------------------------------------------------------
@@ -204,18 +202,24 @@ struct SweepEffect {
 };
 
 const std::vector<SweepEffect> kSweepEffects = {
-    {"plasticity", "creep", [](double a, double p0) { return a * p0; }, "creep = a x default",
+    {"plasticity",
+     "creep",
+     [](double a, double p0) { return a * p0; },
+     "creep = a x default",
      {0.0025, 0.01, 0.04, 0.2, 1.0}},
-    {"viscosity", "fraction", [](double a, double p0) { return a * p0; }, "fraction = a x default",
+    {"viscosity",
+     "fraction",
+     [](double a, double p0) { return a * p0; },
+     "fraction = a x default",
      {0.05, 0.15, 0.5, 1.0, 1.8}},
-    {"friction", "mu", [](double a, double p0) { return p0 / a; }, "1/mu = a x default",
-     {0.1, 0.3, 1.0, 3.0, 30.0}},
-    {"gravity", "g", [](double a, double p0) { return a * p0; }, "g = a x default",
-     {0.05, 0.15, 0.5, 1.0, 3.0}},
-    {"heterogeneity", "ratio", [](double a, double p0) { return 1.0 - a * (1.0 - p0); },
-     "1 - ratio = a x default", {0.05, 0.15, 0.4, 1.0, 1.36}},
-    {"stiffening", "k", [](double a, double p0) { return a * p0; }, "k = a x default",
-     {0.05, 0.2, 1.0, 3.0, 10.0}},
+    {"friction", "mu", [](double a, double p0) { return p0 / a; }, "1/mu = a x default", {0.1, 0.3, 1.0, 3.0, 30.0}},
+    {"gravity", "g", [](double a, double p0) { return a * p0; }, "g = a x default", {0.05, 0.15, 0.5, 1.0, 3.0}},
+    {"heterogeneity",
+     "ratio",
+     [](double a, double p0) { return 1.0 - a * (1.0 - p0); },
+     "1 - ratio = a x default",
+     {0.05, 0.15, 0.4, 1.0, 1.36}},
+    {"stiffening", "k", [](double a, double p0) { return a * p0; }, "k = a x default", {0.05, 0.2, 1.0, 3.0, 10.0}},
 };
 
 // The sweep's scenes: a 2D ring (released by its protocol) and the 3D block released, pressed
@@ -258,9 +262,12 @@ struct Tally {
   int runs = 0, right = 0, wrong = 0, missed = 0;  // missed: consistent verdict
   void add(const std::string& truth, const std::string& found) {
     ++runs;
-    if (found == truth) ++right;
-    else if (found == "none") ++missed;
-    else ++wrong;
+    if (found == truth)
+      ++right;
+    else if (found == "none")
+      ++missed;
+    else
+      ++wrong;
   }
 };
 
@@ -269,8 +276,10 @@ using Bins = std::array<Tally, 4>;
 void print_tally_row(const std::string& label, const Bins& bins, const Tally& all) {
   std::printf("  %-14s", label.c_str());
   for (const Tally& t : bins) {
-    if (t.runs == 0) std::printf(" %9s", "-");
-    else std::printf(" %5d/%-3d", t.right, t.runs);
+    if (t.runs == 0)
+      std::printf(" %9s", "-");
+    else
+      std::printf(" %5d/%-3d", t.right, t.runs);
   }
   std::printf(" %5d/%-3d  wrong %d, missed %d\n", all.right, all.runs, all.wrong, all.missed);
 }
@@ -287,8 +296,8 @@ void effect_size_sweep(bool quick) {
     for (double a : sweep.amplitudes) std::printf(" %g", a);
     std::printf("\n");
   }
-  std::printf("  %-12s %-13s %-20s %9s  %-15s %-13s %7s %8s\n", "scenario", "truth", "parameter",
-              "rms/noise", "verdict", "found", "improv", "wall s");
+  std::printf("  %-12s %-13s %-20s %9s  %-15s %-13s %7s %8s\n", "scenario", "truth", "parameter", "rms/noise",
+              "verdict", "found", "improv", "wall s");
   std::map<std::string, Bins> by_effect;
   std::map<std::string, Tally> effect_all;
   Bins bins;
@@ -296,13 +305,13 @@ void effect_size_sweep(bool quick) {
   int control_runs = 0, false_alarms = 0;
   double wall_total = 0;
   std::uint64_t seed = 5000;
-  auto row = [&](const std::string& scenario, const std::string& effect, const std::string& parameter,
-                 double ratio, const Timed& timed) {
+  auto row = [&](const std::string& scenario, const std::string& effect, const std::string& parameter, double ratio,
+                 const Timed& timed) {
     const auto& d = timed.result.diagnosis;
     std::printf("  %-12s %-13s %-20s %9s  %-15s %-13s %7.3f %8.2f%s%s\n", scenario.c_str(), effect.c_str(),
                 parameter.c_str(), size_text(ratio).c_str(), timed.error.empty() ? d.verdict.c_str() : "error",
-                d.effect.c_str(), d.improvement, timed.wall_s, timed.error.empty() ? "" : "  error: ",
-                timed.error.c_str());
+                d.effect.c_str(), d.improvement, timed.wall_s,
+                timed.error.empty() ? "" : "  error: ", timed.error.c_str());
     std::fflush(stdout);
     wall_total += timed.wall_s;
   };
@@ -374,18 +383,17 @@ void speed() {
   large.options.release = true;
   large.options.rate_hz = 299.0 / 5.0;
   large.options.block_grid = {10, 10, 5};
-  std::printf("  %-28s %9s %6s %9s %9s %8s  %s\n", "recording", "particles", "frames", "wall s", "cpu s",
-              "budget s", "verdict (wall / cpu)");
+  std::printf("  %-28s %9s %6s %9s %9s %8s  %s\n", "recording", "particles", "frames", "wall s", "cpu s", "budget s",
+              "verdict (wall / cpu)");
   for (SpeedCase* c : {&small, &large}) {
     c->options.noise = kSweepNoise;
     c->options.seed = 7;
     const ScenarioResult scene = pliant::host::make_scenario(c->scenario, c->options);
     const Timed timed = timed_diagnose(scene.recording);
     const auto verdict = [&](double t) { return t <= c->budget_s ? "within" : "OVER"; };
-    std::printf("  %-28s %9d %6d %9.2f %9.2f %8.0f  %s / %s%s%s\n", c->label.c_str(),
-                scene.recording.particle_count, scene.recording.frame_count(), timed.wall_s, timed.cpu_s,
-                c->budget_s, verdict(timed.wall_s), verdict(timed.cpu_s), timed.error.empty() ? "" : "  error: ",
-                timed.error.c_str());
+    std::printf("  %-28s %9d %6d %9.2f %9.2f %8.0f  %s / %s%s%s\n", c->label.c_str(), scene.recording.particle_count,
+                scene.recording.frame_count(), timed.wall_s, timed.cpu_s, c->budget_s, verdict(timed.wall_s),
+                verdict(timed.cpu_s), timed.error.empty() ? "" : "  error: ", timed.error.c_str());
     std::fflush(stdout);
   }
   std::printf("\n");

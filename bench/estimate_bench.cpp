@@ -69,24 +69,18 @@ void BM_Estimate(benchmark::State& bench, const char* scene_name, FitMode mode, 
 
 void register_all() {
   auto add = [](const char* name, auto fn) { benchmark::RegisterBenchmark(name, fn)->Unit(benchmark::kMillisecond); };
-  add("estimate/foam_press/2d/double/trajectory", [](benchmark::State& s) {
-    BM_Estimate<2, double>(s, "foam_press", FitMode::trajectory, false);
-  });
-  add("estimate/foam_press/2d/double/final_equilibrium", [](benchmark::State& s) {
-    BM_Estimate<2, double>(s, "foam_press", FitMode::final_equilibrium, false);
-  });
-  add("estimate/foam_press/2d/double/trajectory+alpha", [](benchmark::State& s) {
-    BM_Estimate<2, double>(s, "foam_press", FitMode::trajectory, true);
-  });
-  add("estimate/foam_press/2d/float/trajectory", [](benchmark::State& s) {
-    BM_Estimate<2, float>(s, "foam_press", FitMode::trajectory, false);
-  });
-  add("estimate/block_press/3d/double/trajectory", [](benchmark::State& s) {
-    BM_Estimate<3, double>(s, "block_press", FitMode::trajectory, false);
-  });
-  add("estimate/block_press/3d/double/final_equilibrium", [](benchmark::State& s) {
-    BM_Estimate<3, double>(s, "block_press", FitMode::final_equilibrium, false);
-  });
+  add("estimate/foam_press/2d/double/trajectory",
+      [](benchmark::State& s) { BM_Estimate<2, double>(s, "foam_press", FitMode::trajectory, false); });
+  add("estimate/foam_press/2d/double/final_equilibrium",
+      [](benchmark::State& s) { BM_Estimate<2, double>(s, "foam_press", FitMode::final_equilibrium, false); });
+  add("estimate/foam_press/2d/double/trajectory+alpha",
+      [](benchmark::State& s) { BM_Estimate<2, double>(s, "foam_press", FitMode::trajectory, true); });
+  add("estimate/foam_press/2d/float/trajectory",
+      [](benchmark::State& s) { BM_Estimate<2, float>(s, "foam_press", FitMode::trajectory, false); });
+  add("estimate/block_press/3d/double/trajectory",
+      [](benchmark::State& s) { BM_Estimate<3, double>(s, "block_press", FitMode::trajectory, false); });
+  add("estimate/block_press/3d/double/final_equilibrium",
+      [](benchmark::State& s) { BM_Estimate<3, double>(s, "block_press", FitMode::final_equilibrium, false); });
 }
 
 }  // namespace

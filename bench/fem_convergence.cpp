@@ -83,7 +83,8 @@ Row study(const std::string& name, const TetMesh& mesh) {
     const fem::FemStaticResult result = solver.solve_static(Eigen::VectorXd(), force, options);
     double mean = 0;
     for (int i = 0; i < model.node_count(); ++i) {
-      mean += weight[static_cast<std::size_t>(i)] * (result.position_m[3 * i + axis] - model.rest_position_m()[3 * i + axis]);
+      mean += weight[static_cast<std::size_t>(i)] *
+              (result.position_m[3 * i + axis] - model.rest_position_m()[3 * i + axis]);
     }
     row.deflection[k] = -mean / tip_area / load;  // compliance, m/N
   }
@@ -138,10 +139,10 @@ int main(int argc, char** argv) {
               "defl z m/N", "err z", "f1 z Hz", "err", "defl y m/N", "err y", "f1 y Hz", "err", "wall s", "cpu s");
   auto print = [&](const Row& r) {
     std::printf("%-22s %8d %7d | %12.6g %+7.2f%% %10.6g %+7.2f%% | %12.6g %+7.2f%% %10.6g %+7.2f%% | %7.2f %7.2f\n",
-                r.name.c_str(),
-                r.tets, r.nodes, r.deflection[0], 100 * (r.deflection[0] / eb_compliance[0] - 1), r.f1[0],
-                100 * (r.f1[0] / eb_f1[0] - 1), r.deflection[1], 100 * (r.deflection[1] / eb_compliance[1] - 1), r.f1[1],
-                100 * (r.f1[1] / eb_f1[1] - 1), r.seconds, r.cpu_seconds);
+                r.name.c_str(), r.tets, r.nodes, r.deflection[0], 100 * (r.deflection[0] / eb_compliance[0] - 1),
+                r.f1[0], 100 * (r.f1[0] / eb_f1[0] - 1), r.deflection[1],
+                100 * (r.deflection[1] / eb_compliance[1] - 1), r.f1[1], 100 * (r.f1[1] / eb_f1[1] - 1), r.seconds,
+                r.cpu_seconds);
     std::fflush(stdout);
   };
   for (const char* name : {"bar-6.msh", "bar-186.msh", "bar-651.msh", "bar-2523.msh"}) {
@@ -157,7 +158,8 @@ int main(int argc, char** argv) {
     const int s = 1 << level;
     const std::array<int, 3> cells = {20 * s, 1 * s, 2 * s};
     const TetMesh box = fem::make_box_tet_mesh({kLength, kWidthY, kHeightZ}, cells);
-    print(study("box " + std::to_string(cells[0]) + "x" + std::to_string(cells[1]) + "x" + std::to_string(cells[2]), box));
+    print(study("box " + std::to_string(cells[0]) + "x" + std::to_string(cells[1]) + "x" + std::to_string(cells[2]),
+                box));
   }
   return 0;
 }

@@ -65,9 +65,8 @@ void modulus_row(const char* run, const YoungsModulusEstimate& e) {
               e.converged ? "" : "  (not converged)");
 }
 
-YoungsModulusEstimate run_force(const FemRecordingProblem& problem, double start, int threads = 1,
-                                bool rescale = true, RobustLoss loss = RobustLoss::huber,
-                                LoadSpread spread = LoadSpread::uniform_traction) {
+YoungsModulusEstimate run_force(const FemRecordingProblem& problem, double start, int threads = 1, bool rescale = true,
+                                RobustLoss loss = RobustLoss::huber, LoadSpread spread = LoadSpread::uniform_traction) {
   YoungsModulusOptions o;
   o.initial_youngs_modulus_pa = start;
   o.threads = threads;
@@ -96,8 +95,8 @@ void table_ii(bool quick) {
         std::printf("  %-26s failed: %s\n", run, ex.what());
       }
     }
-    modulus_row("start 1x, equal shares", run_force(problem, kFoamPa, 1, true, RobustLoss::huber,
-                                                    LoadSpread::equal_shares));
+    modulus_row("start 1x, equal shares",
+                run_force(problem, kFoamPa, 1, true, RobustLoss::huber, LoadSpread::equal_shares));
     StepeScenarioOptions kuhn = foam_press();
     kuhn.generation_refinement = {1, 1, 1};
     kuhn.generation_split = BoxSplit::kuhn;
@@ -137,8 +136,8 @@ void table_iii() {
     double depth_m;
     double tilt_deg;
   };
-  for (const Row& row : {Row{"horizontal", 0.02, 0}, Row{"horizontal", 0.04, 0}, Row{"tilted", 0.02, 25},
-                         Row{"tilted", 0.04, 25}}) {
+  for (const Row& row :
+       {Row{"horizontal", 0.02, 0}, Row{"horizontal", 0.04, 0}, Row{"tilted", 0.02, 25}, Row{"tilted", 0.04, 25}}) {
     StepeScenarioOptions so;
     so.control = ProbeControl::displacement;
     so.depth_m = row.depth_m;
@@ -180,8 +179,7 @@ void phantoms() {
   for (const auto& sample : samples) {
     const double reference =
         3e3 * parameters.at("engineering").at(sample[0]).at("Neo Hookean").at("parameters").at(0).get<double>();
-    const FemRecordingProblem problem =
-        fem_problem_from_recording(pliant::host::read_recording(dir + "/" + sample[1]));
+    const FemRecordingProblem problem = fem_problem_from_recording(pliant::host::read_recording(dir + "/" + sample[1]));
     for (bool offset : {false, true}) {
       ReactionEstimateOptions o;
       o.max_nominal_strain = 0.10;

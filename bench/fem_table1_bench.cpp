@@ -61,8 +61,8 @@ struct Row {
 int rows_ok = 0, rows_total = 0;
 
 void print_rows(const std::vector<Row>& rows) {
-  std::printf("  %-18s %11s %11s %11s %10s %9s %9s  %s\n", "parameter", "truth", "paper", "ours", "ours sd", "paper err",
-              "ours err", "ours <= paper");
+  std::printf("  %-18s %11s %11s %11s %10s %9s %9s  %s\n", "parameter", "truth", "paper", "ours", "ours sd",
+              "paper err", "ours err", "ours <= paper");
   for (const Row& r : rows) {
     const double paper_error = std::max(std::abs(r.paper - r.truth) / r.truth, printed_precision(r.paper, r.truth));
     const double ours_error = std::abs(r.ours - r.truth) / r.truth;
@@ -125,8 +125,8 @@ void print_run(const char* title, const Generated& g, const fem::TrajectoryEstim
     std::printf("  continuation on leading windows: %d iterations, %d residual evaluations\n", e.window_iterations,
                 e.window_evaluations);
   }
-  std::printf("  fit: %d iterations, %d residual evaluations, %d simulations, rms %.3g m -> %.3g m, %s\n",
-              e.iterations, e.evaluations, e.simulations, e.start_residual_rms_m, e.residual_rms_m,
+  std::printf("  fit: %d iterations, %d residual evaluations, %d simulations, rms %.3g m -> %.3g m, %s\n", e.iterations,
+              e.evaluations, e.simulations, e.start_residual_rms_m, e.residual_rms_m,
               e.converged ? "converged" : "NOT converged");
   std::printf("  %s: %.1f s wall, %.1f s CPU (all threads)\n", title, e.wall_time_s, e.cpu_time_s);
 }
@@ -207,8 +207,9 @@ int main(int argc, char** argv) {
 
   std::printf("\nparameters at least as accurate as the paper: %d of %d\n", rows_ok, rows_total);
   if (settings.one_point) {
-    std::printf("budget: 1-control-point estimate <= 60 s wall on 2 cores: %.1f s wall (%.1f s CPU / 2 = %.1f s) -> %s\n",
-                budget_wall, budget_cpu, budget_cpu / 2, budget_wall <= 60 ? "PASS" : "FAIL");
+    std::printf(
+        "budget: 1-control-point estimate <= 60 s wall on 2 cores: %.1f s wall (%.1f s CPU / 2 = %.1f s) -> %s\n",
+        budget_wall, budget_cpu, budget_cpu / 2, budget_wall <= 60 ? "PASS" : "FAIL");
   }
   return 0;
 }

@@ -70,7 +70,8 @@ Percentiles percentiles(std::vector<double> values) {
 
 double wall_ns() {
   return static_cast<double>(
-      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count());
+      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+          .count());
 }
 
 int run(int argc, char** argv) {
@@ -262,10 +263,11 @@ int run(int argc, char** argv) {
   const Percentiles frame_cycles = percentiles(frame_cycle_cpu);
   std::printf("guard_bench (%s build): %ld cycles at 1 kHz, %ld episodes of 4 s\n", PLIANT_BENCH_BUILD_TYPE, cycles,
               (cycles + kEpisodeCycles - 1) / kEpisodeCycles);
-  std::printf("object: 3D ball, %d particles, %d clusters, %d memberships; table %d betas x %d closures "
-              "(step %.3f mm); init %.3f s CPU, %ld msm_steps, %d unconverged\n",
-              n, model.model.cluster_count, model.model.membership_count, guard.beta_points, guard.closure_points,
-              guard.closure_step_m * 1e3, init_s, guard.relaxation_steps, guard.unconverged_relaxations);
+  std::printf(
+      "object: 3D ball, %d particles, %d clusters, %d memberships; table %d betas x %d closures "
+      "(step %.3f mm); init %.3f s CPU, %ld msm_steps, %d unconverged\n",
+      n, model.model.cluster_count, model.model.membership_count, guard.beta_points, guard.closure_points,
+      guard.closure_step_m * 1e3, init_s, guard.relaxation_steps, guard.unconverged_relaxations);
   std::printf("\n%-52s %9s %9s %9s %9s\n", "latency (us)", "p50", "p99", "p99.9", "max");
   auto row = [](const char* name, const Percentiles& p) {
     std::printf("%-52s %9.3f %9.3f %9.3f %9.3f\n", name, p.p50 * 1e-3, p.p99 * 1e-3, p.p999 * 1e-3, p.max * 1e-3);
@@ -275,15 +277,16 @@ int run(int argc, char** argv) {
   row("camera frame (grasp_guard_measure_strain), CPU", strain);
   row("cycles carrying a frame (strain + update), CPU", frame_cycles);
   row("timer overhead (one empty interval), CPU", timer);
-  std::printf("\nverdicts: ok %ld, limit %ld, stop %ld; %ld transitions out of ok; slip cycles %ld; frames %ld; "
-              "status %s\n",
-              verdicts[0], verdicts[1], verdicts[2], not_ok_transitions, slip_cycles, frames, status_name(worst_status));
+  std::printf(
+      "\nverdicts: ok %ld, limit %ld, stop %ld; %ld transitions out of ok; slip cycles %ld; frames %ld; "
+      "status %s\n",
+      verdicts[0], verdicts[1], verdicts[2], not_ok_transitions, slip_cycles, frames, status_name(worst_status));
   std::printf("allocations over the %ld cycles: news %zu, deletes %zu, mallocs %zu, frees %zu (malloc %s)\n", cycles,
               allocations.news, allocations.deletes, allocations.mallocs, allocations.frees,
               test::malloc_interposed() ? "interposed" : "not interposed in this build: new/delete only");
   std::printf("counters: refused gripper %u wrench %u camera %u estimate %u; stale camera cycles %u\n",
-              guard.counters.refused[0], guard.counters.refused[1], guard.counters.refused[2], guard.counters.refused[3],
-              guard.counters.stale_cycles[2]);
+              guard.counters.refused[0], guard.counters.refused[1], guard.counters.refused[2],
+              guard.counters.refused[3], guard.counters.stale_cycles[2]);
 
   constexpr double kBudgetUs = 20.0;
   const double p999_us = all_cpu.p999 * 1e-3;

@@ -115,13 +115,8 @@ void BM_MsmStep(benchmark::State& bench) {
 
 void register_all() {
   auto add = [](const char* name, void (*fn)(benchmark::State&)) {
-    benchmark::RegisterBenchmark(name, fn)
-        ->ArgName("N")
-        ->Arg(32)
-        ->Arg(256)
-        ->Arg(1024)
-        ->Arg(4096)
-        ->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(name, fn)->ArgName("N")->Arg(32)->Arg(256)->Arg(1024)->Arg(4096)->Unit(
+        benchmark::kMicrosecond);
   };
   add("msm_step/2d/float", &BM_MsmStep<2, float>);
   add("msm_step/2d/double", &BM_MsmStep<2, double>);

@@ -126,7 +126,8 @@ void register_all() {
   auto add = [](const char* name, auto fn) { benchmark::RegisterBenchmark(name, fn)->Unit(benchmark::kMicrosecond); };
   add("online_update/foam_press/2d/double", [](benchmark::State& s) { BM_OnlineUpdate<2, double>(s, "foam_press"); });
   add("online_update/foam_press/2d/float", [](benchmark::State& s) { BM_OnlineUpdate<2, float>(s, "foam_press"); });
-  add("online_update/foam_press/3d/double", [](benchmark::State& s) { BM_OnlineUpdate<3, double>(s, "foam_press_3d"); });
+  add("online_update/foam_press/3d/double",
+      [](benchmark::State& s) { BM_OnlineUpdate<3, double>(s, "foam_press_3d"); });
   add("online_update/foam_press/3d/float", [](benchmark::State& s) { BM_OnlineUpdate<3, float>(s, "foam_press_3d"); });
   add("online_update/block_press/3d/double", [](benchmark::State& s) { BM_OnlineUpdate<3, double>(s, "block_press"); });
   add("online_update/block_press/3d/float", [](benchmark::State& s) { BM_OnlineUpdate<3, float>(s, "block_press"); });

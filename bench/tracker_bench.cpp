@@ -97,7 +97,8 @@ void register_all() {
   auto add = [](const char* name, auto fn) { benchmark::RegisterBenchmark(name, fn)->Unit(benchmark::kMicrosecond); };
   add("tracker_update/foam_press/2d/double", [](benchmark::State& s) { BM_TrackerUpdate<2, double>(s, "foam_press"); });
   add("tracker_update/foam_press/2d/float", [](benchmark::State& s) { BM_TrackerUpdate<2, float>(s, "foam_press"); });
-  add("tracker_update/block_press/3d/double", [](benchmark::State& s) { BM_TrackerUpdate<3, double>(s, "block_press"); });
+  add("tracker_update/block_press/3d/double",
+      [](benchmark::State& s) { BM_TrackerUpdate<3, double>(s, "block_press"); });
   add("tracker_update/block_press/3d/float", [](benchmark::State& s) { BM_TrackerUpdate<3, float>(s, "block_press"); });
   add("tracker_update/block_1000/3d/double", [](benchmark::State& s) { BM_TrackerUpdate<3, double>(s, "block_1000"); });
   add("tracker_update/block_1000/3d/float", [](benchmark::State& s) { BM_TrackerUpdate<3, float>(s, "block_1000"); });

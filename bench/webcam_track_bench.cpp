@@ -9,10 +9,10 @@
 //
 // Frames: a smooth random texture (blurred noise, fixed seed) under a slow rotation, scale and
 // drift, rendered before timing. Particles: the paper's 4 x 8 grid over the middle of the
-// frame, 100 px apart at 1920x1080 and 64 px at 640x480 (both: DIS at its fast preset's scale 2). One timed frame = FlowAdvector::observe
-// (forward flow, backward flow for the forward-backward check, windowed means, patch checks)
-// plus commit. Also timed: the same without the backward flow, and the whole pipeline
-// (track_particles: decoding from memory, grey conversion, the core tracker, roles).
+// frame, 100 px apart at 1920x1080 and 64 px at 640x480 (both: DIS at its fast preset's scale 2). One timed frame =
+// FlowAdvector::observe (forward flow, backward flow for the forward-backward check, windowed means, patch checks) plus
+// commit. Also timed: the same without the backward flow, and the whole pipeline (track_particles: decoding from
+// memory, grey conversion, the core tracker, roles).
 //
 //   webcam_track_bench [--frames N] [--quick]
 #include <time.h>
@@ -156,10 +156,12 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  std::printf("webcam_track_bench (build type %s, OpenCV %s, %d OpenCV threads)\n", PLIANT_BENCH_BUILD_TYPE,
-              CV_VERSION, cv::getNumThreads());
-  std::printf("per frame: flow + advection of a 4x8 grid (window 10 px, LK refinement %d px, patch checks); wall and CPU (all threads)\n\n",
-              AdvectionConfig{}.refine_window_px);
+  std::printf("webcam_track_bench (build type %s, OpenCV %s, %d OpenCV threads)\n", PLIANT_BENCH_BUILD_TYPE, CV_VERSION,
+              cv::getNumThreads());
+  std::printf(
+      "per frame: flow + advection of a 4x8 grid (window 10 px, LK refinement %d px, patch checks); wall and CPU (all "
+      "threads)\n\n",
+      AdvectionConfig{}.refine_window_px);
   std::printf("%-10s %-10s %-36s %8s %8s %8s %10s  %s\n", "frame", "flow", "settings", "wall ms", "wall f/s", "cpu ms",
               "2-core f/s", "target (CPU time)");
 
@@ -180,11 +182,12 @@ int main(int argc, char** argv) {
     const bool met = dis.fps_two_cores() >= c.target_fps;
     all_met = all_met && met;
     std::snprintf(target, sizeof target, ">= %.0f fps: %s", c.target_fps, met ? "met" : "MISSED");
-    row(c.name, "dis", "scale " + std::to_string(scale) + " (spacing " + std::to_string(static_cast<int>(c.spacing)) +
-                           " px), fb check",
+    row(c.name, "dis",
+        "scale " + std::to_string(scale) + " (spacing " + std::to_string(static_cast<int>(c.spacing)) +
+            " px), fb check",
         dis, target);
-    row(c.name, "dis", "scale 1 (spacing < 64 px), fb check", time_advection(frames, FlowMethod::dis, 1, true, c.spacing),
-        "");
+    row(c.name, "dis", "scale 1 (spacing < 64 px), fb check",
+        time_advection(frames, FlowMethod::dis, 1, true, c.spacing), "");
     row(c.name, "dis", "scale " + std::to_string(scale) + ", no fb check",
         time_advection(frames, FlowMethod::dis, scale, false, c.spacing), "");
     row(c.name, "dis", "scale " + std::to_string(scale) + ", fb check, no LK refinement",

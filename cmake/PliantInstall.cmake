@@ -1,26 +1,67 @@
-# Install and export so that find_package(pliant) works from an install prefix.
+# Install and export, so that find_package(pliant COMPONENTS ...) works from an install prefix.
+# One export set per component (cmake/components/README.md):
+#   core       pliant::core, pliant::bridge, pliant::hal (always)
+#   host       the host libraries (pliant::recording ... pliant::replay) and pliant::host
+#   vision     pliant::vision_webcam, pliant::vision_depth
+#   <driver>   pliant::driver_<driver> for each driver built (socketcan, modbus, opencv, libcamera,
+#              openni2, usb)
+# Each component's dependencies are found again by cmake/components/<component>.cmake, installed
+# beside the targets. The `pliant` program is installed too, outside any export set.
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
+set(pliant_cmake_dir ${CMAKE_INSTALL_LIBDIR}/cmake/pliant)
 
-set(PLIANT_INSTALL_TARGETS pliant_core pliant_bridge pliant_hal)
-if(PLIANT_BUILD_HOST)
-  list(APPEND PLIANT_INSTALL_TARGETS pliant_host pliant)
-endif()
-install(TARGETS ${PLIANT_INSTALL_TARGETS} EXPORT pliantTargets
-  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
-  LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
-  RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+# pliant_install_component(<component> <target> ...): installs the targets in export set
+# pliant-<component>-targets, and the component's dependency script.
+function(pliant_install_component component)
+  install(TARGETS ${ARGN} EXPORT pliant-${component}-targets
+    ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+    LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+    RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+  install(EXPORT pliant-${component}-targets NAMESPACE pliant:: DESTINATION ${pliant_cmake_dir})
+  if(EXISTS ${PROJECT_SOURCE_DIR}/cmake/components/${component}.cmake)
+    install(FILES ${PROJECT_SOURCE_DIR}/cmake/components/${component}.cmake
+      DESTINATION ${pliant_cmake_dir} RENAME pliant-${component}-dependencies.cmake)
+  endif()
+  set(PLIANT_INSTALLED_COMPONENTS ${PLIANT_INSTALLED_COMPONENTS} ${component} PARENT_SCOPE)
+endfunction()
+
+set(PLIANT_INSTALLED_COMPONENTS "")
+pliant_install_component(core pliant_core pliant_bridge pliant_hal)
 install(DIRECTORY core/include/pliant DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(DIRECTORY hal/include/pliant DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(DIRECTORY firmware-bridge/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} FILES_MATCHING PATTERN "*.h")
-if(PLIANT_BUILD_HOST)
+
+if(PLIANT_BUILD_HOST AND PLIANT_HOST_LIBRARIES)
+  pliant_install_component(host ${PLIANT_HOST_LIBRARIES} pliant_host)
   install(DIRECTORY host/include/pliant DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+  set(pliant_vision_targets "")
+  foreach(part webcam depth)
+    if(TARGET pliant_vision_${part})
+      list(APPEND pliant_vision_targets pliant_vision_${part})
+      install(DIRECTORY host/vision/${part}/include/pliant DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+    endif()
+  endforeach()
+  if(pliant_vision_targets)
+    pliant_install_component(vision ${pliant_vision_targets})
+  endif()
+  if(TARGET pliant)
+    install(TARGETS pliant RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+  endif()
 endif()
-install(EXPORT pliantTargets NAMESPACE pliant:: DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/pliant)
+
+foreach(driver socketcan modbus opencv libcamera openni2 usb)
+  if(TARGET pliant_driver_${driver})
+    pliant_install_component(${driver} pliant_driver_${driver})
+    install(DIRECTORY drivers/${driver}/include/pliant DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
+      PATTERN emulator EXCLUDE)  # the device emulators are test peers, not installed
+  endif()
+endforeach()
+
 configure_package_config_file(cmake/pliantConfig.cmake.in
   ${PROJECT_BINARY_DIR}/pliantConfig.cmake
-  INSTALL_DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/pliant)
+  INSTALL_DESTINATION ${pliant_cmake_dir})
 write_basic_package_version_file(${PROJECT_BINARY_DIR}/pliantConfigVersion.cmake
   COMPATIBILITY SameMinorVersion)
 install(FILES ${PROJECT_BINARY_DIR}/pliantConfig.cmake ${PROJECT_BINARY_DIR}/pliantConfigVersion.cmake
-  DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/pliant)
+  DESTINATION ${pliant_cmake_dir})

@@ -5,6 +5,9 @@ set -euo pipefail
 
 packages=(
   cmake g++ make pkg-config      # build
+  ninja-build ccache             # tools/test.sh: Ninja builds, every compile cached
+  clang-format clang-tidy        # tools/lint.sh
+  python3                        # tools/lint_tidy.py
   libeigen3-dev                  # core linear algebra (the only core dependency)
   nlohmann-json3-dev             # recording and result JSON (host)
   libcli11-dev                   # the pliant command line

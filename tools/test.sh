@@ -1,31 +1,84 @@
 #!/usr/bin/env bash
-# Every test: install what is missing, build, run the unit, integration, acceptance and install
-# tests, then all but the slow acceptance runs (ctest label) under AddressSanitizer +
-# UndefinedBehaviorSanitizer, then the cross builds (tools/cross.sh: the aarch64 tests under qemu,
-# the Cortex-M7 firmware with its no-allocator check), then a short libFuzzer smoke run of every
-# parser and decoder.
-# Usage: bash tools/test.sh
+# Every test, in stages, each timed:
+#   setup      install what is missing (tools/setup-debian.sh)
+#   release    build everything (Release) and run every test: unit, integration, acceptance,
+#              install consumers
+#   sanitize   AddressSanitizer + UndefinedBehaviorSanitizer build of what parses outside input or
+#              runs real-time code (PLIANT_SANITIZE_SCOPE=input, see tests/CMakeLists.txt), and
+#              its tests except the slow acceptance runs
+#   cross      tools/cross.sh: the aarch64 tests under qemu, the Cortex-M7 firmware with its
+#              no-allocator check
+#   fuzz       a short libFuzzer smoke run of every parser and decoder (.ci/fuzz_smoke.sh)
+#   lint       tools/lint.sh: formatting and static checks
+# Every build goes through ccache (installed by the set-up script, cache in ~/.cache/ccache), so a
+# rerun on the same machine recompiles only what changed.
+# Usage: bash tools/test.sh [STAGE ...]      (no argument: every stage, in the order above)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+root=$PWD
 jobs=$(nproc)
-bash tools/setup-debian.sh
+export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$root}   # cache hits across clones in other folders
+export CCACHE_MAXSIZE=${CCACHE_MAXSIZE:-12G}     # release, sanitizer, fuzz and cross objects
+export CCACHE_COMPILERCHECK=${CCACHE_COMPILERCHECK:-content}
+export CMAKE_GENERATOR=${CMAKE_GENERATOR:-Ninja}   # every configure below, the scripts' included
 
-echo "== release build and tests"
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release > /dev/null
-cmake --build build -j"$jobs"
-ctest --test-dir build -j"$jobs" --output-on-failure
+# Sends every compiler call of every configure below (cross.sh's and fuzz_smoke.sh's included)
+# through ccache, once the set-up stage has installed it.
+use_ccache() {
+  if command -v ccache > /dev/null; then
+    export CMAKE_C_COMPILER_LAUNCHER=ccache CMAKE_CXX_COMPILER_LAUNCHER=ccache
+  fi
+}
+use_ccache
 
-echo "== AddressSanitizer + UndefinedBehaviorSanitizer"
-cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPLIANT_SANITIZE=ON -DPLIANT_BUILD_BENCHMARKS=OFF > /dev/null
-cmake --build build-asan -j"$jobs"
-ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-  ctest --test-dir build-asan -j"$jobs" --output-on-failure -LE acceptance -E install_consumer
+setup() { bash tools/setup-debian.sh; }
 
-echo "== cross builds: aarch64 under qemu, Cortex-M7 firmware"
-bash tools/cross.sh
+release() {
+  cmake -S . -B build -DCMAKE_BUILD_TYPE=Release > /dev/null
+  cmake --build build -j"$jobs"
+  ctest --test-dir build -j"$jobs" --output-on-failure
+}
 
-echo "== libFuzzer smoke run"
-# Shorter than the script's defaults, to keep the whole run within CI's time budget; run
-# .ci/fuzz_smoke.sh alone for the longer default durations.
-PLIANT_FUZZ_SECONDS=${PLIANT_FUZZ_SECONDS:-30} PLIANT_MESH_FUZZ_SECONDS=${PLIANT_MESH_FUZZ_SECONDS:-20} \
-  PLIANT_CSV_FUZZ_SECONDS=${PLIANT_CSV_FUZZ_SECONDS:-20} bash .ci/fuzz_smoke.sh
+sanitize() {
+  cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPLIANT_SANITIZE=ON \
+    -DPLIANT_SANITIZE_SCOPE=input -DPLIANT_BUILD_BENCHMARKS=OFF > /dev/null
+  cmake --build build-asan -j"$jobs"
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+    ctest --test-dir build-asan -j"$jobs" --output-on-failure -LE acceptance -E install_consumer
+}
+
+cross() { bash tools/cross.sh; }
+
+fuzz() {
+  # Shorter than the script's defaults, to keep the whole run within CI's time budget; run
+  # .ci/fuzz_smoke.sh alone for the longer default durations.
+  PLIANT_FUZZ_SECONDS=${PLIANT_FUZZ_SECONDS:-30} PLIANT_MESH_FUZZ_SECONDS=${PLIANT_MESH_FUZZ_SECONDS:-20} \
+    PLIANT_CSV_FUZZ_SECONDS=${PLIANT_CSV_FUZZ_SECONDS:-20} bash .ci/fuzz_smoke.sh
+}
+
+lint() { bash tools/lint.sh; }
+
+stages=("$@")
+[ ${#stages[@]} -gt 0 ] || stages=(setup release sanitize cross fuzz lint)
+for stage in "${stages[@]}"; do
+  case $stage in
+    setup | release | sanitize | cross | fuzz | lint) ;;
+    *) echo "usage: $0 [setup|release|sanitize|cross|fuzz|lint ...]" >&2; exit 2 ;;
+  esac
+done
+
+timings=()
+started_all=$SECONDS
+for stage in "${stages[@]}"; do
+  echo "== stage $stage"
+  started=$SECONDS
+  "$stage"
+  timings+=("$(printf '%-9s %5d s' "$stage" $((SECONDS - started)))")
+  echo "== stage $stage done in $((SECONDS - started)) s"
+  use_ccache
+done
+
+echo "== stage durations"
+printf '   %s\n' "${timings[@]}"
+printf '   %-9s %5d s\n' total $((SECONDS - started_all))
+if command -v ccache > /dev/null; then ccache --show-stats | sed -n '1,6p' | sed 's/^/   ccache: /'; fi

@@ -13,9 +13,8 @@ template <int Dim, typename Scalar>
 Status check_inputs(const MsmModel<Dim, Scalar>& model, const ObservationSequence<Dim, Scalar>& obs,
                     const DeformabilityConfig& config, const DeformabilityWorkspace<Dim, Scalar>& ws) noexcept {
   if (!model.initialized() || !ws.state.initialized()) return Status::not_initialized;
-  if (config.grid_points < 3 || !(config.tolerance > 0) || config.max_refinements < 0 ||
-      !(config.alpha_min > 0) || !(config.alpha_min <= 1) || config.equilibrium_max_iterations < 1 ||
-      !(config.equilibrium_tolerance > 0)) {
+  if (config.grid_points < 3 || !(config.tolerance > 0) || config.max_refinements < 0 || !(config.alpha_min > 0) ||
+      !(config.alpha_min <= 1) || config.equilibrium_max_iterations < 1 || !(config.equilibrium_tolerance > 0)) {
     return Status::invalid_argument;
   }
   if (ws.curve_capacity < config.grid_points + config.max_refinements || ws.grid_capacity < config.grid_points) {
@@ -88,8 +87,8 @@ bool all_observed(const ObservationSequence<Dim, Scalar>& obs) noexcept {
 // over frames, from which the estimator measures how much of the residual persists in time.
 template <bool kAllObserved, int Dim, typename Scalar>
 void accumulate_frame(const MsmModel<Dim, Scalar>& model, const ObservationSequence<Dim, Scalar>& obs, int k,
-                      const MsmState<Dim, Scalar>& state, Eigen::Matrix<double, Dim, 1>* residual_sum,
-                      double* samples, TrajectoryError& error) noexcept {
+                      const MsmState<Dim, Scalar>& state, Eigen::Matrix<double, Dim, 1>* residual_sum, double* samples,
+                      TrajectoryError& error) noexcept {
   // Hot loop of every evaluation (once per frame): plain arrays and local sums, so that nothing
   // is reloaded through the output pointers. Same arithmetic, in the same order, as
   // (position - observation).cast<double>() and its squaredNorm.
@@ -211,7 +210,7 @@ void run_final(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>&
     }
   }
   accumulate_frame<false>(model, obs, obs.frame_count - 1, state, static_cast<Eigen::Matrix<double, Dim, 1>*>(nullptr),
-                   nullptr, error);
+                          nullptr, error);
 }
 
 // Whether the curvature of the sum of squares at the estimate may come from the refinement's
@@ -230,7 +229,8 @@ bool local_curvature_possible(const DeformabilityConfig& config) noexcept {
 template <int Dim, typename Scalar>
 Status evaluate_error(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>& params,
                       const ObservationSequence<Dim, Scalar>& obs, const DeformabilityConfig& config,
-                      bool observed_everywhere, DeformabilityWorkspace<Dim, Scalar>& ws, TrajectoryError& error) noexcept {
+                      bool observed_everywhere, DeformabilityWorkspace<Dim, Scalar>& ws,
+                      TrajectoryError& error) noexcept {
   error = TrajectoryError{};
   if (config.mode == FitMode::trajectory) {
     run_trajectory(model, params, obs, observed_everywhere, ws, error);
@@ -297,12 +297,12 @@ struct Point {
   double value = 0;
 };
 template <typename F>
-Minimum brent_minimum(F&& f, double a, double b, Point x, Point w, Point v, double tolerance,
-                      int max_evaluations, bool smooth) noexcept {
+Minimum brent_minimum(F&& f, double a, double b, Point x, Point w, Point v, double tolerance, int max_evaluations,
+                      bool smooth) noexcept {
   constexpr double kGolden = 0.38196601125010515;  // (3 - sqrt 5) / 2
   const double tol1 = 0.25 * tolerance;
-  double step = 0.0;           // last step taken
-  double earlier = b - a;      // the step before it
+  double step = 0.0;       // last step taken
+  double earlier = b - a;  // the step before it
   for (int evaluations = 0; evaluations < max_evaluations; ++evaluations) {
     const double middle = 0.5 * (a + b);
     if (std::max(x.x - a, b - x.x) <= 2.0 * tol1) break;
@@ -342,12 +342,18 @@ Minimum brent_minimum(F&& f, double a, double b, Point x, Point w, Point v, doub
     const double u = x.x + (std::abs(step) >= tol1 ? step : (step >= 0.0 ? tol1 : -tol1));
     const Point trial{u, f(u)};
     if (trial.value <= x.value) {
-      if (u >= x.x) a = x.x; else b = x.x;
+      if (u >= x.x)
+        a = x.x;
+      else
+        b = x.x;
       v = w;
       w = x;
       x = trial;
     } else {
-      if (u < x.x) a = u; else b = u;
+      if (u < x.x)
+        a = u;
+      else
+        b = u;
       if (trial.value <= w.value || w.x == x.x) {
         v = w;
         w = trial;
@@ -596,7 +602,8 @@ Status estimate_deformability(const MsmModel<Dim, Scalar>& model, const MsmParam
   auto profile = [&](double alpha) -> double {
     params.msm_alpha = static_cast<Scalar>(alpha);
     DeformabilityResult trial;
-    const Status s = search_beta(model, params, observations, inner, observed_everywhere, workspace, false, false, progress, trial);
+    const Status s =
+        search_beta(model, params, observations, inner, observed_everywhere, workspace, false, false, progress, trial);
     result.evaluations += trial.evaluations;
     return s == Status::ok ? trial.error : std::numeric_limits<double>::infinity();
   };
@@ -623,15 +630,15 @@ Status estimate_deformability(const MsmModel<Dim, Scalar>& model, const MsmParam
   return search_beta(model, params, observations, config, observed_everywhere, workspace, true, true, progress, result);
 }
 
-#define PLIANT_INSTANTIATE_DEFORMABILITY(DIM, SCALAR)                                                        \
-  template std::size_t deformability_workspace_size<DIM, SCALAR>(const MsmModel<DIM, SCALAR>&, int,          \
-                                                                 const DeformabilityConfig&) noexcept;       \
-  template Status deformability_workspace_init<DIM, SCALAR>(Arena&, const MsmModel<DIM, SCALAR>&, int,       \
-                                                            const DeformabilityConfig&,                      \
-                                                            DeformabilityWorkspace<DIM, SCALAR>&) noexcept;  \
+#define PLIANT_INSTANTIATE_DEFORMABILITY(DIM, SCALAR)                                                       \
+  template std::size_t deformability_workspace_size<DIM, SCALAR>(const MsmModel<DIM, SCALAR>&, int,         \
+                                                                 const DeformabilityConfig&) noexcept;      \
+  template Status deformability_workspace_init<DIM, SCALAR>(Arena&, const MsmModel<DIM, SCALAR>&, int,      \
+                                                            const DeformabilityConfig&,                     \
+                                                            DeformabilityWorkspace<DIM, SCALAR>&) noexcept; \
   template Status evaluate_deformability_error<DIM, SCALAR>(                                                \
       const MsmModel<DIM, SCALAR>&, const MsmParams<DIM, SCALAR>&, const ObservationSequence<DIM, SCALAR>&, \
-      const DeformabilityConfig&, DeformabilityWorkspace<DIM, SCALAR>&, TrajectoryError&) noexcept;          \
+      const DeformabilityConfig&, DeformabilityWorkspace<DIM, SCALAR>&, TrajectoryError&) noexcept;         \
   template Status estimate_deformability<DIM, SCALAR>(                                                      \
       const MsmModel<DIM, SCALAR>&, const MsmParams<DIM, SCALAR>&, const ObservationSequence<DIM, SCALAR>&, \
       const DeformabilityConfig&, DeformabilityWorkspace<DIM, SCALAR>&, DeformabilityResult&) noexcept;

@@ -105,9 +105,9 @@ void extreme_eigenvalues(const Eigen::Matrix<double, 3, 3>& m, double& low, doub
   // det(B) / 2 with B = (A - mean I) / spread.
   const double det = b00 * (b11 * b22 - a12 * a12) - a01 * (a01 * b22 - a12 * a02) + a02 * (a01 * a12 - b11 * a02);
   const double r = std::clamp(det / (2 * spread2 * spread), -1.0, 1.0);
-  const double c = std::cos(std::acos(r) / 3);   // cos(phi), phi in [0, pi/3]
+  const double c = std::cos(std::acos(r) / 3);  // cos(phi), phi in [0, pi/3]
   const double s = std::sqrt(std::max(0.0, 1 - c * c));
-  high = mean + 2 * spread * c;                           // cos(phi)
+  high = mean + 2 * spread * c;                                   // cos(phi)
   low = mean + 2 * spread * (-0.5 * c - 0.8660254037844386 * s);  // cos(phi + 2 pi / 3)
 }
 
@@ -127,7 +127,8 @@ bool cluster_strain(const MsmModel<Dim, Scalar>& model, const Eigen::Matrix<doub
   for (int k = begin; k < end; ++k) {
     const int j = model.members[k];
     const VecD p = x[j].template cast<double>() - reference;
-    apq.noalias() += static_cast<double>(model.mass[j]) * p * model.member_rest_offset[k].template cast<double>().transpose();
+    apq.noalias() +=
+        static_cast<double>(model.mass[j]) * p * model.member_rest_offset[k].template cast<double>().transpose();
   }
   const MatD a = apq * model.cluster_aqq_inverse[c].template cast<double>();
   // A non-finite member (an unobserved particle) makes the fit non-finite: checked once here.
@@ -169,14 +170,14 @@ bool positive(double value) noexcept { return finite(value) && value > 0; }
 bool positive_or_inf(double value) noexcept { return value > 0 && !std::isnan(value); }
 
 Status validate(const GraspGuardConfig& c) noexcept {
-  const bool limits = positive_or_inf(c.max_strain) && positive_or_inf(c.max_indentation_m) &&
-                      positive(c.max_force_n) &&
-                      (std::isnan(c.nominal_force_n) || (positive(c.nominal_force_n) && c.nominal_force_n <= c.max_force_n));
+  const bool limits =
+      positive_or_inf(c.max_strain) && positive_or_inf(c.max_indentation_m) && positive(c.max_force_n) &&
+      (std::isnan(c.nominal_force_n) || (positive(c.nominal_force_n) && c.nominal_force_n <= c.max_force_n));
   const bool contact = (std::isnan(c.contact_width_m) || positive(c.contact_width_m)) && finite(c.contact_force_n) &&
                        c.contact_force_n >= 0 && positive_or_inf(c.contact_width_tolerance) && positive(c.max_width_m);
-  const bool force = c.force_source == ForceSource::force_sensor ||
-                     (c.force_source == ForceSource::motor_current && positive(c.current_gain_n_per_a) &&
-                      finite(c.current_offset_a));
+  const bool force =
+      c.force_source == ForceSource::force_sensor ||
+      (c.force_source == ForceSource::motor_current && positive(c.current_gain_n_per_a) && finite(c.current_offset_a));
   const bool timing = positive(c.gripper_timeout_s) && positive(c.wrench_timeout_s) && positive(c.camera_timeout_s) &&
                       positive(c.estimate_timeout_s) && positive(c.cycle_timeout_s) && finite(c.clock_tolerance_s) &&
                       c.clock_tolerance_s >= 0 && c.wrench_frozen_samples >= 0;
@@ -190,7 +191,8 @@ Status validate(const GraspGuardConfig& c) noexcept {
                     c.slip_floor_n >= 0 && finite(c.slip_ceiling_n) && c.slip_ceiling_n >= c.slip_floor_n &&
                     finite(c.slip_force_rate_per_s) && c.slip_force_rate_per_s >= 0;
   const bool fit = positive(c.force_fit_spacing_m) && finite(c.force_fit_forgetting) && c.force_fit_forgetting > 0 &&
-                   c.force_fit_forgetting <= 1 && finite(c.force_model_min_closure_m) && c.force_model_min_closure_m >= 0;
+                   c.force_fit_forgetting <= 1 && finite(c.force_model_min_closure_m) &&
+                   c.force_model_min_closure_m >= 0;
   const bool table = c.prediction_beta_points >= 2 && c.prediction_beta_points <= 1001 &&
                      c.prediction_closure_points >= 2 && c.prediction_closure_points <= 100000 &&
                      c.prediction_refine_steps >= 1 && c.prediction_refine_steps <= 1000 &&
@@ -209,23 +211,23 @@ template <int Dim, typename Scalar>
 struct Squeeze {
   using Vec = Eigen::Matrix<Scalar, Dim, 1>;
   MsmState<Dim, Scalar> state;
-  std::int8_t* initial_side = nullptr;  // [n] -1 jaw A, +1 jaw B, 0 free
-  std::int8_t* side = nullptr;          // [n]
-  Vec* anchor = nullptr;                // [n] position on the jaw when the particle joined
-  double* anchor_closure = nullptr;     // [n] closure when it joined
-  int* ids = nullptr;                   // [n]
-  Vec* targets = nullptr;               // [n]
-  Vec* previous = nullptr;              // [n]
-  Vec* saved_position = nullptr;        // [n]
+  std::int8_t* initial_side = nullptr;                     // [n] -1 jaw A, +1 jaw B, 0 free
+  std::int8_t* side = nullptr;                             // [n]
+  Vec* anchor = nullptr;                                   // [n] position on the jaw when the particle joined
+  double* anchor_closure = nullptr;                        // [n] closure when it joined
+  int* ids = nullptr;                                      // [n]
+  Vec* targets = nullptr;                                  // [n]
+  Vec* previous = nullptr;                                 // [n]
+  Vec* saved_position = nullptr;                           // [n]
   ClusterRotation<Dim, Scalar>* saved_rotation = nullptr;  // [clusters]
-  std::int8_t* saved_side = nullptr;    // [n]
-  Vec* saved_anchor = nullptr;          // [n]
-  double* saved_anchor_closure = nullptr;  // [n]
+  std::int8_t* saved_side = nullptr;                       // [n]
+  Vec* saved_anchor = nullptr;                             // [n]
+  double* saved_anchor_closure = nullptr;                  // [n]
 };
 
 template <int Dim, typename Scalar>
-Status carve(Arena& arena, const MsmModel<Dim, Scalar>& model, const GraspGuardConfig& config, GraspGuard<Dim, Scalar>& guard,
-             Squeeze<Dim, Scalar>& squeeze) noexcept {
+Status carve(Arena& arena, const MsmModel<Dim, Scalar>& model, const GraspGuardConfig& config,
+             GraspGuard<Dim, Scalar>& guard, Squeeze<Dim, Scalar>& squeeze) noexcept {
   using Vec = Eigen::Matrix<Scalar, Dim, 1>;
   const auto n = static_cast<std::size_t>(model.particle_count);
   const auto clusters = static_cast<std::size_t>(model.cluster_count);
@@ -270,9 +272,14 @@ template <int Dim, typename Scalar>
 class SqueezeRun {
  public:
   using Vec = Eigen::Matrix<Scalar, Dim, 1>;
-  SqueezeRun(const MsmModel<Dim, Scalar>& model, Squeeze<Dim, Scalar>& squeeze, const Vec& axis, double low, double high,
-             const GraspGuardConfig& config, const Eigen::Matrix<double, Dim, Dim>* null) noexcept
-      : model_(model), s_(squeeze), axis_(axis), low_(low), high_(high), null_(null),
+  SqueezeRun(const MsmModel<Dim, Scalar>& model, Squeeze<Dim, Scalar>& squeeze, const Vec& axis, double low,
+             double high, const GraspGuardConfig& config, const Eigen::Matrix<double, Dim, Dim>* null) noexcept
+      : model_(model),
+        s_(squeeze),
+        axis_(axis),
+        low_(low),
+        high_(high),
+        null_(null),
         tolerance_(relax_tolerance(model, config)),
         max_iterations_(config.relax_max_iterations) {}
 
@@ -346,7 +353,8 @@ class SqueezeRun {
         ++steps_;
         --budget;
         double move = 0;
-        for (int i = 0; i < n; ++i) move = std::max(move, static_cast<double>((s_.state.position[i] - s_.previous[i]).norm()));
+        for (int i = 0; i < n; ++i)
+          move = std::max(move, static_cast<double>((s_.state.position[i] - s_.previous[i]).norm()));
         quiet = move <= tolerance_ ? quiet + 1 : 0;
       }
       int joined = 0;
@@ -584,8 +592,8 @@ Status grasp_guard_init(Arena& arena, const MsmModel<Dim, Scalar>& model, const 
   // (strain = closure / extent), at most half the extent. Strain concentrates at the jaws, so
   // crossings come earlier, and past twice the threshold the rows are extrapolated anyway.
   const double uniform = 2 * config.max_strain * (1 + config.stop_overshoot) * extent;
-  const double max_closure = std::isnan(config.prediction_max_closure_m) ? std::min(0.5 * extent, uniform)
-                                                                          : config.prediction_max_closure_m;
+  const double max_closure =
+      std::isnan(config.prediction_max_closure_m) ? std::min(0.5 * extent, uniform) : config.prediction_max_closure_m;
   if (!(max_closure < extent)) return Status::invalid_argument;
   if (finite(config.contact_width_m) && finite(config.contact_width_tolerance) &&
       std::abs(config.contact_width_m - extent) > config.contact_width_tolerance * extent) {
@@ -683,7 +691,8 @@ Status grasp_guard_init(Arena& arena, const MsmModel<Dim, Scalar>& model, const 
           if (relaxed != Status::ok) return relaxed;
           strain = run.strain();
           refined[r] = strain;
-          if (std::isnan(crossing) && strain > limit) crossing = ((k - 1) + static_cast<double>(r - 1) / refine) * g.closure_step_m;
+          if (std::isnan(crossing) && strain > limit)
+            crossing = ((k - 1) + static_cast<double>(r - 1) / refine) * g.closure_step_m;
         }
       }
       row[k] = strain;
@@ -746,7 +755,8 @@ double grasp_guard_predicted_strain(const GraspGuard<Dim, Scalar>& guard, double
 }
 
 template <int Dim, typename Scalar>
-double grasp_guard_strain_safe_closure(const GraspGuard<Dim, Scalar>& guard, double beta_low, double beta_high) noexcept {
+double grasp_guard_strain_safe_closure(const GraspGuard<Dim, Scalar>& guard, double beta_low,
+                                       double beta_high) noexcept {
   if (!guard.initialized()) return 0;
   int first = 0;
   int last = 0;
@@ -762,32 +772,58 @@ Status grasp_guard_measure_strain(const MsmModel<Dim, Scalar>& model, const Gras
                                   GraspStrainMeasurement& measurement) noexcept {
   measurement = GraspStrainMeasurement{};
   if (!guard.initialized() || !model.initialized()) return Status::not_initialized;
-  if (positions == nullptr || model.particle_count != guard.particle_count || model.cluster_count != guard.cluster_count) {
+  if (positions == nullptr || model.particle_count != guard.particle_count ||
+      model.cluster_count != guard.cluster_count) {
     return Status::invalid_argument;
   }
   measurement = measure(model, guard.cluster_null, positions);
   return measurement.clusters_measured > 0 ? Status::ok : Status::no_observations;
 }
 
-// --- the cycle -----------------------------------------------------------------------------------
+// --- the cycle's stages ---------------------------------------------------------------------------
 
-template <int Dim, typename Scalar>
-Status grasp_guard_update(GraspGuard<Dim, Scalar>& guard, const GraspGuardInput& input, GraspGuardOutput& output) noexcept {
-  output = GraspGuardOutput{};
-  if (!guard.initialized()) {
-    output.reasons = reason_bit(GuardReason::not_configured);
-    return Status::not_initialized;
-  }
-  const GraspGuardConfig& config = guard.config;
-  GraspGuardState& s = guard.state;
-  GraspGuardCounters& counters = guard.counters;
-  const int needed = config.clear_samples;
-  const double margin = config.hysteresis_margin;
-  ++counters.cycles;
+namespace {
 
-  // The clock: a non-finite now, a now going backwards, or a gap longer than cycle_timeout_s.
+// What the cycle has established so far, handed from stage to stage.
+struct Cycle {
+  int needed = 1;            // consecutive clear samples that clear a latch (clear_samples)
+  double dt = 0;             // since the last good cycle, at most cycle_timeout_s
+  bool clock_known = false;  // a good now was seen: stamps can be aged and caught in the future
+  double reference = 0;      // this cycle's now, or the last good one
+  SampleCheck gripper;
+  SampleCheck wrench;
+  SampleCheck camera;
+  SampleCheck estimate;
+  bool gripper_new = false;  // a usable gripper sample not seen before
+  double closure = 0;        // contact width - width, >= 0 (0 before contact)
+};
+
+// The prediction and the closures it allows.
+struct Limits {
+  double beta_low = 0;
+  double beta_high = 1;
+  double strain_safe = 0;
+  double predicted_strain = kNaN;
+  double stiffness = kNaN;
+  double force_safe = kInf;
+  double safe = 0;
+};
+
+// The verdict and the reasons behind it.
+struct Decision {
+  GraspVerdict severity[kGuardReasonCount] = {};  // per active reason
+  std::uint32_t reasons = 0;
+  std::uint8_t fault_sources = 0;
+  GraspVerdict verdict = GraspVerdict::ok;
+  GuardReason dominant = GuardReason::none;
+  StopAction action = StopAction::freeze;
+};
+
+// The clock: a non-finite now, a now going backwards, or a gap longer than cycle_timeout_s. A
+// refused now leaves the last good one as the reference the samples are checked against.
+void read_clock(const GraspGuardConfig& config, double now, GraspGuardState& s, GraspGuardCounters& counters,
+                Cycle& cycle) noexcept {
   bool clock_raw[kFaultKindCount] = {};
-  const double now = input.now_s;
   double dt = 0;
   if (!finite(now)) {
     clock_raw[kNan] = true;
@@ -802,191 +838,262 @@ Status grasp_guard_update(GraspGuard<Dim, Scalar>& guard, const GraspGuardInput&
     s.last_now_s = now;
     s.has_now = true;
   }
-  const bool clock_known = s.has_now;
-  const double reference = s.last_now_s;  // this cycle's now, or the last good one
+  cycle.dt = dt;
+  cycle.clock_known = s.has_now;
+  cycle.reference = s.last_now_s;
   const int clock = source_index(GuardSource::clock);
   for (int kind = 0; kind < kFaultKindCount; ++kind) {
-    step_latch(s.fault[kind][clock], clock_raw[kind], !clock_raw[kind], true, needed);
+    step_latch(s.fault[kind][clock], clock_raw[kind], !clock_raw[kind], true, cycle.needed);
   }
   if (clock_raw[kNan] || clock_raw[kInvalid]) ++counters.refused[clock];
   if (clock_raw[kTimeout]) ++counters.stale_cycles[clock];
+}
 
-  auto check = [&](GuardSource which, const SampleFields& fields) {
-    return check_sample(s, source_index(which), clock_known, reference, config.clock_tolerance_s, fields);
-  };
-  auto apply = [&](GuardSource which, SampleCheck& result) {
-    apply_sample(s, counters, source_index(which), needed, result);
-  };
+// check_sample against this cycle's clock.
+SampleCheck check_source(const GraspGuardConfig& config, GuardSource which, const SampleFields& fields,
+                         GraspGuardState& s, const Cycle& cycle) noexcept {
+  return check_sample(s, source_index(which), cycle.clock_known, cycle.reference, config.clock_tolerance_s, fields);
+}
 
-  // Gripper.
-  const GripperSample& gripper = input.gripper;
+// Grip force from the configured source: the force sensor, or the motor current.
+double grip_force(const GraspGuardConfig& config, const GripperSample& gripper) noexcept {
   const bool by_current = config.force_source == ForceSource::motor_current;
-  const double raw_force = by_current ? config.current_gain_n_per_a * (gripper.current_a - config.current_offset_a)
-                                      : gripper.force_n;
+  return by_current ? config.current_gain_n_per_a * (gripper.current_a - config.current_offset_a) : gripper.force_n;
+}
+
+SampleFields gripper_fields(const GraspGuardConfig& config, const GripperSample& gripper, double raw_force) noexcept {
   const bool gripper_finite = finite(gripper.width_m) && finite(raw_force);
-  const bool gripper_range = !gripper_finite || (gripper.width_m >= 0 && gripper.width_m <= config.max_width_m);
-  SampleFields gripper_fields;
-  gripper_fields.stamp = gripper.stamp_s;
-  gripper_fields.values_finite = gripper_finite;
-  gripper_fields.valid = gripper.valid;
-  gripper_fields.range_ok = gripper_range;
-  gripper_fields.status_bits = gripper.status_bits;
-  gripper_fields.mask = config.gripper_fault_mask;
-  gripper_fields.bus_off = gripper.bus_off;
-  gripper_fields.timeout = gripper.timeout;
-  gripper_fields.max_age = config.gripper_timeout_s;
-  SampleCheck g = check(GuardSource::gripper, gripper_fields);
-  apply(GuardSource::gripper, g);
-  const bool gripper_new = g.usable && g.new_sample;
+  SampleFields fields;
+  fields.stamp = gripper.stamp_s;
+  fields.values_finite = gripper_finite;
+  fields.valid = gripper.valid;
+  // A non-finite width is a nan_input, not also out of range.
+  fields.range_ok = !gripper_finite || (gripper.width_m >= 0 && gripper.width_m <= config.max_width_m);
+  fields.status_bits = gripper.status_bits;
+  fields.mask = config.gripper_fault_mask;
+  fields.bus_off = gripper.bus_off;
+  fields.timeout = gripper.timeout;
+  fields.max_age = config.gripper_timeout_s;
+  return fields;
+}
+
+// First contact: at the configured contact width, or else at the first usable sample with at
+// least contact_force_n, whose width must then agree with the model's extent (wrong object or
+// unit otherwise).
+void detect_contact(const GraspGuardConfig& config, double extent, GraspGuardState& s) noexcept {
+  if (s.in_contact) return;
+  if (finite(config.contact_width_m)) {
+    if (s.width_m <= config.contact_width_m) {
+      s.in_contact = true;
+      s.contact_width_m = config.contact_width_m;
+    }
+  } else if (s.force_n >= config.contact_force_n) {
+    s.in_contact = true;
+    s.contact_width_m = s.width_m;
+    s.geometry_mismatch = finite(config.contact_width_tolerance) &&
+                          std::abs(s.contact_width_m - extent) > config.contact_width_tolerance * extent;
+  }
+}
+
+// The gripper: a usable sample updates width, force and contact; the closure follows from the
+// last usable width (a refused sample keeps the previous one).
+void read_gripper(const GraspGuardConfig& config, double extent, const GripperSample& gripper, GraspGuardState& s,
+                  GraspGuardCounters& counters, Cycle& cycle) noexcept {
+  const double raw_force = grip_force(config, gripper);
+  SampleCheck& g = cycle.gripper;
+  g = check_source(config, GuardSource::gripper, gripper_fields(config, gripper, raw_force), s, cycle);
+  apply_sample(s, counters, source_index(GuardSource::gripper), cycle.needed, g);
+  cycle.gripper_new = g.usable && g.new_sample;
   if (g.usable) {
     s.width_m = gripper.width_m;
     s.force_n = raw_force;
     s.has_gripper = true;
-    if (!s.in_contact) {
-      if (finite(config.contact_width_m)) {
-        if (s.width_m <= config.contact_width_m) {
-          s.in_contact = true;
-          s.contact_width_m = config.contact_width_m;
-        }
-      } else if (s.force_n >= config.contact_force_n) {
-        s.in_contact = true;
-        s.contact_width_m = s.width_m;
-        s.geometry_mismatch = finite(config.contact_width_tolerance) &&
-                              std::abs(s.contact_width_m - guard.extent_m) > config.contact_width_tolerance * guard.extent_m;
-      }
-    }
+    detect_contact(config, extent, s);
   }
-  const double closure = s.in_contact && s.has_gripper ? std::max(0.0, s.contact_width_m - s.width_m) : 0.0;
+  cycle.closure = s.in_contact && s.has_gripper ? std::max(0.0, s.contact_width_m - s.width_m) : 0.0;
+}
 
-  // Force fit: samples admitted every force_fit_spacing_m of closure, so a hold adds nothing.
-  if (gripper_new && s.in_contact && std::abs(closure - s.fit_last_closure_m) >= config.force_fit_spacing_m) {
-    const double keep = config.force_fit_forgetting;
-    if (s.fit_samples > 0) s.fit_segment_slope = (s.force_n - s.fit_last_force_n) / (closure - s.fit_last_closure_m);
-    s.fit_last_force_n = s.force_n;
-    s.fit_w = keep * s.fit_w + 1;
-    s.fit_x = keep * s.fit_x + closure;
-    s.fit_y = keep * s.fit_y + s.force_n;
-    s.fit_xx = keep * s.fit_xx + closure * closure;
-    s.fit_xy = keep * s.fit_xy + closure * s.force_n;
-    ++s.fit_samples;
-    s.fit_last_closure_m = closure;
+// Force fit: samples admitted every force_fit_spacing_m of closure, so a hold adds nothing.
+void admit_force_fit_sample(const GraspGuardConfig& config, const Cycle& cycle, GraspGuardState& s) noexcept {
+  const double closure = cycle.closure;
+  if (!(cycle.gripper_new && s.in_contact && std::abs(closure - s.fit_last_closure_m) >= config.force_fit_spacing_m)) {
+    return;
   }
+  const double keep = config.force_fit_forgetting;
+  if (s.fit_samples > 0) s.fit_segment_slope = (s.force_n - s.fit_last_force_n) / (closure - s.fit_last_closure_m);
+  s.fit_last_force_n = s.force_n;
+  s.fit_w = keep * s.fit_w + 1;
+  s.fit_x = keep * s.fit_x + closure;
+  s.fit_y = keep * s.fit_y + s.force_n;
+  s.fit_xx = keep * s.fit_xx + closure * closure;
+  s.fit_xy = keep * s.fit_xy + closure * s.force_n;
+  ++s.fit_samples;
+  s.fit_last_closure_m = closure;
+}
 
-  // Wrench: the slip cue's high-pass, and the frozen-sensor check.
-  const WrenchSample& wrench = input.wrench;
+SampleFields wrench_fields(const GraspGuardConfig& config, const WrenchSample& wrench) noexcept {
   bool wrench_finite = true;
   for (double v : wrench.wrench) wrench_finite = wrench_finite && finite(v);
-  SampleFields wrench_fields;
-  wrench_fields.stamp = wrench.stamp_s;
-  wrench_fields.values_finite = wrench_finite;
-  wrench_fields.valid = wrench.valid;
-  wrench_fields.range_ok = true;
-  wrench_fields.status_bits = wrench.status_bits;
-  wrench_fields.mask = config.wrench_fault_mask;
-  wrench_fields.bus_off = wrench.bus_off;
-  wrench_fields.timeout = wrench.timeout;
-  wrench_fields.max_age = config.wrench_timeout_s;
-  SampleCheck w = check(GuardSource::wrench, wrench_fields);
-  // A frozen sensor repeats its last reading bit for bit (a live one always has noise in the
-  // low bits); it counts as stale.
-  if (w.new_sample && wrench_finite) {
-    const bool repeated = s.frozen_seen && std::memcmp(wrench.wrench, s.previous_wrench, sizeof wrench.wrench) == 0;
-    s.frozen_count = repeated ? s.frozen_count + 1 : 0;
-    std::memcpy(s.previous_wrench, wrench.wrench, sizeof wrench.wrench);
-    s.frozen_seen = true;
-  }
-  if (config.wrench_frozen_samples > 0 && s.frozen_count >= config.wrench_frozen_samples) w.raw[kStale] = true;
-  apply(GuardSource::wrench, w);
-  const bool wrench_usable = w.usable;
-  if (wrench_usable && w.new_sample) {
-    if (!s.has_wrench) {
-      for (int d = 0; d < 3; ++d) {
-        s.previous_force[d] = wrench.wrench[d];
-        s.high_pass[d] = 0;
-      }
-      s.has_wrench = true;
-    } else {
-      const double tau = 1.0 / (2.0 * kPi * config.slip_cutoff_hz);
-      const double dt_w = std::max(0.0, wrench.stamp_s - s.wrench_stamp_s);
-      const double a = tau / (tau + dt_w);
-      for (int d = 0; d < 3; ++d) {
-        s.high_pass[d] = a * (s.high_pass[d] + wrench.wrench[d] - s.previous_force[d]);
-        s.previous_force[d] = wrench.wrench[d];
-      }
+  SampleFields fields;
+  fields.stamp = wrench.stamp_s;
+  fields.values_finite = wrench_finite;
+  fields.valid = wrench.valid;
+  fields.range_ok = true;
+  fields.status_bits = wrench.status_bits;
+  fields.mask = config.wrench_fault_mask;
+  fields.bus_off = wrench.bus_off;
+  fields.timeout = wrench.timeout;
+  fields.max_age = config.wrench_timeout_s;
+  return fields;
+}
+
+// A frozen sensor repeats its last reading bit for bit (a live one always has noise in the low
+// bits): counts the consecutive repeats.
+void track_frozen_wrench(const WrenchSample& wrench, GraspGuardState& s) noexcept {
+  // Bitwise on purpose: the values are finite (checked before), and "the same bits" is the test.
+  // NOLINTNEXTLINE(bugprone-suspicious-memory-comparison)
+  const bool repeated = s.frozen_seen && std::memcmp(wrench.wrench, s.previous_wrench, sizeof wrench.wrench) == 0;
+  s.frozen_count = repeated ? s.frozen_count + 1 : 0;
+  std::memcpy(s.previous_wrench, wrench.wrench, sizeof wrench.wrench);
+  s.frozen_seen = true;
+}
+
+// The slip cue: a first-order high-pass (slip_cutoff_hz) of the wrist force over the samples'
+// own stamps, started at zero by the first sample; slip_force_n is its magnitude.
+void high_pass_wrench(const GraspGuardConfig& config, const WrenchSample& wrench, GraspGuardState& s) noexcept {
+  if (!s.has_wrench) {
+    for (int d = 0; d < 3; ++d) {
+      s.previous_force[d] = wrench.wrench[d];
+      s.high_pass[d] = 0;
     }
-    s.wrench_stamp_s = wrench.stamp_s;
-    s.slip_force_n = std::sqrt(s.high_pass[0] * s.high_pass[0] + s.high_pass[1] * s.high_pass[1] +
-                               s.high_pass[2] * s.high_pass[2]);
+    s.has_wrench = true;
+  } else {
+    const double tau = 1.0 / (2.0 * kPi * config.slip_cutoff_hz);
+    const double dt_w = std::max(0.0, wrench.stamp_s - s.wrench_stamp_s);
+    const double a = tau / (tau + dt_w);
+    for (int d = 0; d < 3; ++d) {
+      s.high_pass[d] = a * (s.high_pass[d] + wrench.wrench[d] - s.previous_force[d]);
+      s.previous_force[d] = wrench.wrench[d];
+    }
   }
+  s.wrench_stamp_s = wrench.stamp_s;
+  s.slip_force_n =
+      std::sqrt(s.high_pass[0] * s.high_pass[0] + s.high_pass[1] * s.high_pass[1] + s.high_pass[2] * s.high_pass[2]);
+}
+
+// Wrench: the frozen-sensor check (a frozen sensor counts as stale), then the slip cue's
+// high-pass on a new usable sample.
+void read_wrench(const GraspGuardConfig& config, const WrenchSample& wrench, GraspGuardState& s,
+                 GraspGuardCounters& counters, Cycle& cycle) noexcept {
+  const SampleFields fields = wrench_fields(config, wrench);
+  SampleCheck& w = cycle.wrench;
+  w = check_source(config, GuardSource::wrench, fields, s, cycle);
+  if (w.new_sample && fields.values_finite) track_frozen_wrench(wrench, s);
+  if (config.wrench_frozen_samples > 0 && s.frozen_count >= config.wrench_frozen_samples) w.raw[kStale] = true;
+  apply_sample(s, counters, source_index(GuardSource::wrench), cycle.needed, w);
+  if (w.usable && w.new_sample) high_pass_wrench(config, wrench, s);
+}
+
+// Slip in contact (the high-passed force over slip_ratio x the grip force, clamped to the floor
+// and ceiling) raises the allowed force at slip_force_rate_per_s, up to max_force_n.
+void update_slip(const GraspGuardConfig& config, const Cycle& cycle, GraspGuardState& s,
+                 GraspGuardCounters& counters) noexcept {
   const double grip = s.has_gripper ? std::abs(s.force_n) : 0.0;
   const double slip_threshold = std::clamp(config.slip_ratio * grip, config.slip_floor_n, config.slip_ceiling_n);
-  s.slip = s.in_contact && wrench_usable && s.has_wrench && s.slip_force_n > slip_threshold;
+  s.slip = s.in_contact && cycle.wrench.usable && s.has_wrench && s.slip_force_n > slip_threshold;
   if (s.slip) {
-    s.allowed_force_n = std::min(config.max_force_n, s.allowed_force_n * (1.0 + config.slip_force_rate_per_s * dt));
+    s.allowed_force_n =
+        std::min(config.max_force_n, s.allowed_force_n * (1.0 + config.slip_force_rate_per_s * cycle.dt));
     ++counters.slip_cycles;
   }
+}
 
-  // Camera.
-  const DeformationSample& deformation = input.deformation;
-  SampleFields camera_fields;
-  camera_fields.stamp = deformation.stamp_s;
-  camera_fields.values_finite = finite(deformation.strain);
-  camera_fields.valid = deformation.valid;
-  camera_fields.range_ok = !(deformation.strain < 0);
-  camera_fields.status_bits = deformation.status_bits;
-  camera_fields.mask = config.camera_fault_mask;
-  camera_fields.bus_off = deformation.bus_off;
-  camera_fields.timeout = deformation.timeout;
-  camera_fields.max_age = config.camera_timeout_s;
-  SampleCheck cam = check(GuardSource::camera, camera_fields);
-  apply(GuardSource::camera, cam);
+SampleFields camera_fields(const GraspGuardConfig& config, const DeformationSample& deformation) noexcept {
+  SampleFields fields;
+  fields.stamp = deformation.stamp_s;
+  fields.values_finite = finite(deformation.strain);
+  fields.valid = deformation.valid;
+  fields.range_ok = !(deformation.strain < 0);
+  fields.status_bits = deformation.status_bits;
+  fields.mask = config.camera_fault_mask;
+  fields.bus_off = deformation.bus_off;
+  fields.timeout = deformation.timeout;
+  fields.max_age = config.camera_timeout_s;
+  return fields;
+}
+
+// Camera: a usable sample updates the measured strain.
+void read_camera(const GraspGuardConfig& config, const DeformationSample& deformation, GraspGuardState& s,
+                 GraspGuardCounters& counters, Cycle& cycle) noexcept {
+  SampleCheck& cam = cycle.camera;
+  cam = check_source(config, GuardSource::camera, camera_fields(config, deformation), s, cycle);
+  apply_sample(s, counters, source_index(GuardSource::camera), cycle.needed, cam);
   if (cam.usable) {
     s.strain = deformation.strain;
     s.has_strain = true;
   }
+}
 
-  // Estimate. An sd of +inf is a legitimate "not yet identifiable", not a fault.
-  const EstimateSample& estimate = input.estimate;
+// An sd of +inf is a legitimate "not yet identifiable", not a fault.
+SampleFields estimate_fields(const GraspGuardConfig& config, const EstimateSample& estimate) noexcept {
   const bool estimate_finite = finite(estimate.msm_beta) && !std::isnan(estimate.msm_beta_std);
-  const bool estimate_range = !estimate_finite || (estimate.msm_beta >= 0 && estimate.msm_beta <= 1 && estimate.msm_beta_std >= 0);
-  SampleFields estimate_fields;
-  estimate_fields.stamp = estimate.stamp_s;
-  estimate_fields.values_finite = estimate_finite;
-  estimate_fields.valid = estimate.valid;
-  estimate_fields.range_ok = estimate_range;
-  estimate_fields.max_age = config.estimate_timeout_s;
-  SampleCheck est = check(GuardSource::estimate, estimate_fields);
-  apply(GuardSource::estimate, est);
+  SampleFields fields;
+  fields.stamp = estimate.stamp_s;
+  fields.values_finite = estimate_finite;
+  fields.valid = estimate.valid;
+  fields.range_ok =
+      !estimate_finite || (estimate.msm_beta >= 0 && estimate.msm_beta <= 1 && estimate.msm_beta_std >= 0);
+  fields.max_age = config.estimate_timeout_s;
+  return fields;
+}
+
+// Estimate: a usable sample updates msm_beta and its sd.
+void read_estimate(const GraspGuardConfig& config, const EstimateSample& estimate, GraspGuardState& s,
+                   GraspGuardCounters& counters, Cycle& cycle) noexcept {
+  SampleCheck& est = cycle.estimate;
+  est = check_source(config, GuardSource::estimate, estimate_fields(config, estimate), s, cycle);
+  apply_sample(s, counters, source_index(GuardSource::estimate), cycle.needed, est);
   if (est.usable) {
     s.msm_beta = estimate.msm_beta;
     s.msm_beta_std = estimate.msm_beta_std;
     s.has_estimate = true;
   }
+}
 
-  // Prediction. Without a usable, finite-sd estimate the whole beta range.
-  double beta_low = 0;
-  double beta_high = 1;
-  if (est.usable && finite(s.msm_beta_std)) {
-    beta_low = std::clamp(s.msm_beta - config.confidence_k * s.msm_beta_std, 0.0, 1.0);
-    beta_high = std::clamp(s.msm_beta + config.confidence_k * s.msm_beta_std, 0.0, 1.0);
+// The prediction's msm_beta interval: the estimate +- confidence_k sd; without a usable,
+// finite-sd estimate this cycle, the whole range.
+void beta_interval(const GraspGuardConfig& config, const GraspGuardState& s, const Cycle& cycle,
+                   Limits& limits) noexcept {
+  limits.beta_low = 0;
+  limits.beta_high = 1;
+  if (cycle.estimate.usable && finite(s.msm_beta_std)) {
+    limits.beta_low = std::clamp(s.msm_beta - config.confidence_k * s.msm_beta_std, 0.0, 1.0);
+    limits.beta_high = std::clamp(s.msm_beta + config.confidence_k * s.msm_beta_std, 0.0, 1.0);
   }
-  const double strain_safe = grasp_guard_strain_safe_closure(guard, beta_low, beta_high);
-  const double predicted_strain = grasp_guard_predicted_strain(guard, closure, beta_low, beta_high);
-  double stiffness = kNaN;
-  if (s.in_contact && s.has_gripper && closure >= config.force_model_min_closure_m && closure > 0) {
-    // The largest of the secant, the fit's slope (the mean tangent over its window) and the
-    // latest segment's slope (the current tangent): conservative for softening and stiffening.
-    stiffness = std::max(0.0, s.force_n / closure);
-    if (s.fit_samples >= 2 && finite(s.fit_segment_slope)) stiffness = std::max(stiffness, s.fit_segment_slope);
-    if (s.fit_samples >= 3) {
-      const double mean_x = s.fit_x / s.fit_w;
-      const double variance = s.fit_xx / s.fit_w - mean_x * mean_x;
-      if (variance > 0.25 * config.force_fit_spacing_m * config.force_fit_spacing_m) {
-        const double slope = (s.fit_xy / s.fit_w - mean_x * s.fit_y / s.fit_w) / variance;
-        stiffness = std::max(stiffness, slope);
-      }
+}
+
+// The force model's slope (NaN without one: before contact or below force_model_min_closure_m).
+// The largest of the secant, the fit's slope (the mean tangent over its window) and the latest
+// segment's slope (the current tangent): conservative for softening and stiffening.
+double force_stiffness(const GraspGuardConfig& config, const GraspGuardState& s, double closure) noexcept {
+  if (!(s.in_contact && s.has_gripper && closure >= config.force_model_min_closure_m && closure > 0)) return kNaN;
+  double stiffness = std::max(0.0, s.force_n / closure);
+  if (s.fit_samples >= 2 && finite(s.fit_segment_slope)) stiffness = std::max(stiffness, s.fit_segment_slope);
+  if (s.fit_samples >= 3) {
+    const double mean_x = s.fit_x / s.fit_w;
+    const double variance = s.fit_xx / s.fit_w - mean_x * mean_x;
+    // A slope only from a window whose closures spread (sd) over more than half the fit spacing.
+    if (variance > 0.25 * config.force_fit_spacing_m * config.force_fit_spacing_m) {
+      const double slope = (s.fit_xy / s.fit_w - mean_x * s.fit_y / s.fit_w) / variance;
+      stiffness = std::max(stiffness, slope);
     }
   }
+  return stiffness;
+}
+
+// The closure at which the force model reaches allowed_force_n: +inf without a model or with
+// a flat one below the allowed force, the current closure with a flat one at or above it.
+double force_safe_closure(const GraspGuardState& s, double stiffness, double closure) noexcept {
   double force_safe = kInf;
   if (finite(stiffness)) {
     if (stiffness > 0) {
@@ -995,93 +1102,148 @@ Status grasp_guard_update(GraspGuard<Dim, Scalar>& guard, const GraspGuardInput&
       force_safe = closure;
     }
   }
-  const double safe = std::max(0.0, std::min({strain_safe, config.max_indentation_m, force_safe}));
+  return force_safe;
+}
 
-  // Measured limits. Each counts clear samples on its own source.
+// Prediction: the safe closure is the least of the strain table's, the indentation limit and
+// the force model's.
+template <int Dim, typename Scalar>
+Limits compute_limits(const GraspGuard<Dim, Scalar>& guard, const Cycle& cycle) noexcept {
+  const GraspGuardConfig& config = guard.config;
+  const GraspGuardState& s = guard.state;
+  Limits limits;
+  beta_interval(config, s, cycle, limits);
+  limits.strain_safe = grasp_guard_strain_safe_closure(guard, limits.beta_low, limits.beta_high);
+  limits.predicted_strain = grasp_guard_predicted_strain(guard, cycle.closure, limits.beta_low, limits.beta_high);
+  limits.stiffness = force_stiffness(config, s, cycle.closure);
+  limits.force_safe = force_safe_closure(s, limits.stiffness, cycle.closure);
+  limits.safe = std::max(0.0, std::min({limits.strain_safe, config.max_indentation_m, limits.force_safe}));
+  return limits;
+}
+
+// Measured limits, with hysteresis. Each latch steps only on a usable sample of its own source
+// and counts clear samples of that source.
+void step_measured_limits(const GraspGuardConfig& config, const Cycle& cycle, const Limits& limits,
+                          GraspGuardState& s) noexcept {
+  const int needed = cycle.needed;
+  const double margin = config.hysteresis_margin;
   const double overshoot = 1 + config.stop_overshoot;
+  const double closure = cycle.closure;
+  const bool gripper_new = cycle.gripper_new;
   GuardLatch* m = s.measured;
-  if (g.usable) {
+  if (cycle.gripper.usable) {
     step_measured(m[reason_index(GuardReason::force_limit)], s.force_n, s.allowed_force_n, margin, gripper_new, needed);
     step_measured(m[reason_index(GuardReason::force_exceeded)], s.force_n, config.max_force_n * overshoot, margin,
                   gripper_new, needed);
-    step_measured(m[reason_index(GuardReason::indentation_limit)], closure, config.max_indentation_m, margin, gripper_new,
-                  needed);
-    step_measured(m[reason_index(GuardReason::indentation_exceeded)], closure, config.max_indentation_m * overshoot, margin,
+    step_measured(m[reason_index(GuardReason::indentation_limit)], closure, config.max_indentation_m, margin,
                   gripper_new, needed);
-    step_measured(m[reason_index(GuardReason::predicted_strain)], closure, strain_safe, margin, gripper_new, needed);
+    step_measured(m[reason_index(GuardReason::indentation_exceeded)], closure, config.max_indentation_m * overshoot,
+                  margin, gripper_new, needed);
+    step_measured(m[reason_index(GuardReason::predicted_strain)], closure, limits.strain_safe, margin, gripper_new,
+                  needed);
   }
+  const SampleCheck& cam = cycle.camera;
   if (cam.usable) {
-    step_measured(m[reason_index(GuardReason::strain_limit)], s.strain, config.max_strain, margin, cam.new_sample, needed);
+    step_measured(m[reason_index(GuardReason::strain_limit)], s.strain, config.max_strain, margin, cam.new_sample,
+                  needed);
     step_measured(m[reason_index(GuardReason::strain_exceeded)], s.strain, config.max_strain * overshoot, margin,
                   cam.new_sample, needed);
   }
+  const SampleCheck& est = cycle.estimate;
   if (est.usable) {
     step_measured(m[reason_index(GuardReason::estimate_uncertain)], s.msm_beta_std, config.max_beta_std, margin,
                   est.new_sample, needed);
   }
+}
 
-  // The verdict: the most severe active reason, ties to the lower (higher-priority) reason.
-  GraspVerdict severity[kGuardReasonCount] = {};
-  std::uint32_t reasons = 0;
-  std::uint8_t fault_sources = 0;
+// Every active fault latch, as its reason at its source's configured verdict.
+void collect_faults(const GraspGuardConfig& config, const GraspGuardState& s, Decision& d) noexcept {
   for (int kind = 0; kind < kFaultKindCount; ++kind) {
     for (int source = 0; source < kGuardSourceCount; ++source) {
       if (!s.fault[kind][source].active) continue;
       const GuardReason reason = fault_reason(kind, source);
       const int r = reason_index(reason);
-      reasons |= reason_bit(reason);
-      fault_sources = static_cast<std::uint8_t>(fault_sources | (1u << static_cast<unsigned>(source)));
-      severity[r] = std::max(severity[r], config.fault_verdict[source]);
+      d.reasons |= reason_bit(reason);
+      d.fault_sources = static_cast<std::uint8_t>(d.fault_sources | (1u << static_cast<unsigned>(source)));
+      d.severity[r] = std::max(d.severity[r], config.fault_verdict[source]);
     }
   }
-  auto add = [&](GuardReason reason, GraspVerdict verdict) {
-    if (!m[reason_index(reason)].active) return;
-    reasons |= reason_bit(reason);
-    severity[reason_index(reason)] = std::max(severity[reason_index(reason)], verdict);
-  };
-  add(GuardReason::force_exceeded, GraspVerdict::stop);
-  add(GuardReason::strain_exceeded, GraspVerdict::stop);
-  add(GuardReason::indentation_exceeded, GraspVerdict::stop);
-  add(GuardReason::force_limit, GraspVerdict::limit);
-  add(GuardReason::strain_limit, GraspVerdict::limit);
-  add(GuardReason::indentation_limit, GraspVerdict::limit);
-  add(GuardReason::predicted_strain, GraspVerdict::limit);
-  add(GuardReason::estimate_uncertain, config.uncertain_estimate_verdict);
-  if (s.geometry_mismatch) {
-    reasons |= reason_bit(GuardReason::not_configured);
-    severity[reason_index(GuardReason::not_configured)] = GraspVerdict::stop;
-  }
-  GraspVerdict verdict = GraspVerdict::ok;
-  GuardReason dominant = GuardReason::none;
-  for (int r = 1; r < kGuardReasonCount; ++r) {
-    if ((reasons & (1u << static_cast<unsigned>(r))) != 0 && severity[r] > verdict) {
-      verdict = severity[r];
-      dominant = static_cast<GuardReason>(r);
-    }
-  }
-  const bool exceeded = dominant == GuardReason::force_exceeded || dominant == GuardReason::strain_exceeded ||
-                        dominant == GuardReason::indentation_exceeded;
-  StopAction action = exceeded ? config.exceeded_stop_action : config.fault_stop_action;
-  if (config.latch_stop) {
-    if (s.stop_latched) {
-      verdict = GraspVerdict::stop;
-      dominant = s.latched_reason;
-      action = s.latched_action;
-      reasons |= reason_bit(dominant);
-    } else if (verdict == GraspVerdict::stop) {
-      s.stop_latched = true;
-      s.latched_reason = dominant;
-      s.latched_action = action;
-    }
-  }
-  if (verdict == GraspVerdict::limit) ++counters.limit_cycles;
-  if (verdict == GraspVerdict::stop) ++counters.stop_cycles;
+}
 
-  output.verdict = verdict;
-  output.reason = dominant;
-  output.stop_action = action;
-  output.reasons = reasons;
-  output.fault_sources = fault_sources;
+// `reason` at `verdict` when its measured latch is active.
+void raise_measured(const GuardLatch* m, GuardReason reason, GraspVerdict verdict, Decision& d) noexcept {
+  if (!m[reason_index(reason)].active) return;
+  d.reasons |= reason_bit(reason);
+  d.severity[reason_index(reason)] = std::max(d.severity[reason_index(reason)], verdict);
+}
+
+// Every active measured latch, and a contact width that contradicts the model.
+void collect_limits(const GraspGuardConfig& config, const GraspGuardState& s, Decision& d) noexcept {
+  const GuardLatch* m = s.measured;
+  raise_measured(m, GuardReason::force_exceeded, GraspVerdict::stop, d);
+  raise_measured(m, GuardReason::strain_exceeded, GraspVerdict::stop, d);
+  raise_measured(m, GuardReason::indentation_exceeded, GraspVerdict::stop, d);
+  raise_measured(m, GuardReason::force_limit, GraspVerdict::limit, d);
+  raise_measured(m, GuardReason::strain_limit, GraspVerdict::limit, d);
+  raise_measured(m, GuardReason::indentation_limit, GraspVerdict::limit, d);
+  raise_measured(m, GuardReason::predicted_strain, GraspVerdict::limit, d);
+  raise_measured(m, GuardReason::estimate_uncertain, config.uncertain_estimate_verdict, d);
+  if (s.geometry_mismatch) {
+    d.reasons |= reason_bit(GuardReason::not_configured);
+    d.severity[reason_index(GuardReason::not_configured)] = GraspVerdict::stop;
+  }
+}
+
+// The verdict: the most severe active reason, ties to the lower (higher-priority) reason.
+void pick_dominant(Decision& d) noexcept {
+  d.verdict = GraspVerdict::ok;
+  d.dominant = GuardReason::none;
+  for (int r = 1; r < kGuardReasonCount; ++r) {
+    if ((d.reasons & (1u << static_cast<unsigned>(r))) != 0 && d.severity[r] > d.verdict) {
+      d.verdict = d.severity[r];
+      d.dominant = static_cast<GuardReason>(r);
+    }
+  }
+}
+
+// What stop means: exceeded_stop_action for an exceeded limit, else fault_stop_action. With
+// latch_stop a stop holds its reason and action until acknowledged, whatever the inputs do.
+void apply_stop_latch(const GraspGuardConfig& config, GraspGuardState& s, Decision& d) noexcept {
+  const bool exceeded = d.dominant == GuardReason::force_exceeded || d.dominant == GuardReason::strain_exceeded ||
+                        d.dominant == GuardReason::indentation_exceeded;
+  d.action = exceeded ? config.exceeded_stop_action : config.fault_stop_action;
+  if (!config.latch_stop) return;
+  if (s.stop_latched) {
+    d.verdict = GraspVerdict::stop;
+    d.dominant = s.latched_reason;
+    d.action = s.latched_action;
+    d.reasons |= reason_bit(d.dominant);
+  } else if (d.verdict == GraspVerdict::stop) {
+    s.stop_latched = true;
+    s.latched_reason = d.dominant;
+    s.latched_action = d.action;
+  }
+}
+
+Decision decide_verdict(const GraspGuardConfig& config, GraspGuardState& s, GraspGuardCounters& counters) noexcept {
+  Decision d;
+  collect_faults(config, s, d);
+  collect_limits(config, s, d);
+  pick_dominant(d);
+  apply_stop_latch(config, s, d);
+  if (d.verdict == GraspVerdict::limit) ++counters.limit_cycles;
+  if (d.verdict == GraspVerdict::stop) ++counters.stop_cycles;
+  return d;
+}
+
+void fill_output(const GraspGuardState& s, const Cycle& cycle, const Limits& limits, const Decision& d,
+                 GraspGuardOutput& output) noexcept {
+  const double closure = cycle.closure;
+  output.verdict = d.verdict;
+  output.reason = d.dominant;
+  output.stop_action = d.action;
+  output.reasons = d.reasons;
+  output.fault_sources = d.fault_sources;
   output.in_contact = s.in_contact;
   output.slip = s.slip;
   output.contact_width_m = s.contact_width_m;
@@ -1089,35 +1251,68 @@ Status grasp_guard_update(GraspGuard<Dim, Scalar>& guard, const GraspGuardInput&
   output.force_n = s.has_gripper ? s.force_n : kNaN;
   output.strain = s.has_strain ? s.strain : kNaN;
   output.allowed_force_n = s.allowed_force_n;
-  output.beta_low = beta_low;
-  output.beta_high = beta_high;
-  output.predicted_strain = predicted_strain;
-  output.strain_safe_closure_m = strain_safe;
-  output.force_safe_closure_m = force_safe;
-  output.safe_closure_m = safe;
-  output.safe_width_m = s.in_contact ? s.contact_width_m - safe : kNaN;
-  output.stiffness_n_per_m = stiffness;
-  output.predicted_force_n = finite(stiffness) ? s.force_n + stiffness * (safe - closure) : kNaN;
+  output.beta_low = limits.beta_low;
+  output.beta_high = limits.beta_high;
+  output.predicted_strain = limits.predicted_strain;
+  output.strain_safe_closure_m = limits.strain_safe;
+  output.force_safe_closure_m = limits.force_safe;
+  output.safe_closure_m = limits.safe;
+  output.safe_width_m = s.in_contact ? s.contact_width_m - limits.safe : kNaN;
+  output.stiffness_n_per_m = limits.stiffness;
+  output.predicted_force_n = finite(limits.stiffness) ? s.force_n + limits.stiffness * (limits.safe - closure) : kNaN;
   output.slip_force_n = s.slip_force_n;
+}
+
+}  // namespace
+
+// --- the cycle -----------------------------------------------------------------------------------
+
+// The stages run in this order because each reads what the previous ones left in the state:
+// the clock before the samples are aged, the gripper's closure before the force fit and the
+// limits, the slip (which raises allowed_force_n) before the force limits.
+template <int Dim, typename Scalar>
+Status grasp_guard_update(GraspGuard<Dim, Scalar>& guard, const GraspGuardInput& input,
+                          GraspGuardOutput& output) noexcept {
+  output = GraspGuardOutput{};
+  if (!guard.initialized()) {
+    output.reasons = reason_bit(GuardReason::not_configured);
+    return Status::not_initialized;
+  }
+  const GraspGuardConfig& config = guard.config;
+  GraspGuardState& s = guard.state;
+  GraspGuardCounters& counters = guard.counters;
+  ++counters.cycles;
+  Cycle cycle;
+  cycle.needed = config.clear_samples;
+  read_clock(config, input.now_s, s, counters, cycle);
+  read_gripper(config, guard.extent_m, input.gripper, s, counters, cycle);
+  admit_force_fit_sample(config, cycle, s);
+  read_wrench(config, input.wrench, s, counters, cycle);
+  update_slip(config, cycle, s, counters);
+  read_camera(config, input.deformation, s, counters, cycle);
+  read_estimate(config, input.estimate, s, counters, cycle);
+  const Limits limits = compute_limits(guard, cycle);
+  step_measured_limits(config, cycle, limits, s);
+  const Decision decision = decide_verdict(config, s, counters);
+  fill_output(s, cycle, limits, decision, output);
   return Status::ok;
 }
 
-#define PLIANT_INSTANTIATE_GRASP_GUARD(DIM, SCALAR)                                                               \
-  template std::size_t grasp_guard_workspace_size<DIM, SCALAR>(const MsmModel<DIM, SCALAR>&,                      \
-                                                               const GraspGuardConfig&) noexcept;                 \
+#define PLIANT_INSTANTIATE_GRASP_GUARD(DIM, SCALAR)                                                                    \
+  template std::size_t grasp_guard_workspace_size<DIM, SCALAR>(const MsmModel<DIM, SCALAR>&,                           \
+                                                               const GraspGuardConfig&) noexcept;                      \
   template Status grasp_guard_init<DIM, SCALAR>(Arena&, const MsmModel<DIM, SCALAR>&, const GraspObject<DIM, SCALAR>&, \
-                                                const GraspGuardConfig&, GraspGuard<DIM, SCALAR>&) noexcept;        \
-  template void grasp_guard_reset<DIM, SCALAR>(GraspGuard<DIM, SCALAR>&) noexcept;                                \
-  template void grasp_guard_acknowledge_stop<DIM, SCALAR>(GraspGuard<DIM, SCALAR>&) noexcept;                     \
-  template Status grasp_guard_update<DIM, SCALAR>(GraspGuard<DIM, SCALAR>&, const GraspGuardInput&,               \
-                                                  GraspGuardOutput&) noexcept;                                    \
-  template Status grasp_guard_measure_strain<DIM, SCALAR>(const MsmModel<DIM, SCALAR>&, const GraspGuard<DIM, SCALAR>&, \
-                                                          const Eigen::Matrix<SCALAR, DIM, 1>*,                   \
-                                                          GraspStrainMeasurement&) noexcept;                      \
-  template double grasp_guard_predicted_strain<DIM, SCALAR>(const GraspGuard<DIM, SCALAR>&, double, double,       \
-                                                            double) noexcept;                                     \
-  template double grasp_guard_strain_safe_closure<DIM, SCALAR>(const GraspGuard<DIM, SCALAR>&, double,            \
-                                                               double) noexcept;
+                                                const GraspGuardConfig&, GraspGuard<DIM, SCALAR>&) noexcept;           \
+  template void grasp_guard_reset<DIM, SCALAR>(GraspGuard<DIM, SCALAR>&) noexcept;                                     \
+  template void grasp_guard_acknowledge_stop<DIM, SCALAR>(GraspGuard<DIM, SCALAR>&) noexcept;                          \
+  template Status grasp_guard_update<DIM, SCALAR>(GraspGuard<DIM, SCALAR>&, const GraspGuardInput&,                    \
+                                                  GraspGuardOutput&) noexcept;                                         \
+  template Status grasp_guard_measure_strain<DIM, SCALAR>(                                                             \
+      const MsmModel<DIM, SCALAR>&, const GraspGuard<DIM, SCALAR>&, const Eigen::Matrix<SCALAR, DIM, 1>*,              \
+      GraspStrainMeasurement&) noexcept;                                                                               \
+  template double grasp_guard_predicted_strain<DIM, SCALAR>(const GraspGuard<DIM, SCALAR>&, double, double,            \
+                                                            double) noexcept;                                          \
+  template double grasp_guard_strain_safe_closure<DIM, SCALAR>(const GraspGuard<DIM, SCALAR>&, double, double) noexcept;
 PLIANT_INSTANTIATE_GRASP_GUARD(2, float)
 PLIANT_INSTANTIATE_GRASP_GUARD(2, double)
 PLIANT_INSTANTIATE_GRASP_GUARD(3, float)

@@ -169,10 +169,9 @@ Status validate(const MsmModelConfig<Dim, Scalar>& config) noexcept {
       if (cc.k < 1 || cc.k > 64) return Status::invalid_argument;
       break;
     case ClusterLayout::grid_blocks: {
-      const bool sizes_ok = cc.grid_cols > 0 && cc.grid_rows > 0 && cc.grid_layers > 0 &&
-                            cc.block_cols > 0 && cc.block_rows > 0 && cc.block_layers > 0 &&
-                            cc.block_cols <= cc.grid_cols && cc.block_rows <= cc.grid_rows &&
-                            cc.block_layers <= cc.grid_layers;
+      const bool sizes_ok = cc.grid_cols > 0 && cc.grid_rows > 0 && cc.grid_layers > 0 && cc.block_cols > 0 &&
+                            cc.block_rows > 0 && cc.block_layers > 0 && cc.block_cols <= cc.grid_cols &&
+                            cc.block_rows <= cc.grid_rows && cc.block_layers <= cc.grid_layers;
       if (!sizes_ok || static_cast<long long>(cc.grid_cols) * cc.grid_rows * cc.grid_layers != n) {
         return Status::invalid_argument;
       }
@@ -196,7 +195,8 @@ Status build(Arena& arena, const MsmModelConfig<Dim, Scalar>& config, MsmModel<D
 
   // Duplicates: a zero nearest-neighbour distance relative to the object's extent.
   double extent_squared = 0;
-  for (int i = 1; i < n; ++i) extent_squared = std::max(extent_squared, distance_squared<Dim>(config.rest_positions, 0, i));
+  for (int i = 1; i < n; ++i)
+    extent_squared = std::max(extent_squared, distance_squared<Dim>(config.rest_positions, 0, i));
   for (int i = 0; i < n && n > 1; ++i) {
     if (nearest_distance_squared<Dim>(config.rest_positions, n, i) <= 1e-24 * extent_squared) {
       return Status::duplicate_rest_positions;
@@ -235,7 +235,8 @@ Status build(Arena& arena, const MsmModelConfig<Dim, Scalar>& config, MsmModel<D
   m.member_byte_offset = arena.carve<std::int32_t>(static_cast<std::size_t>(memberships));
   m.particle_cluster_byte_offset = arena.carve<std::int32_t>(static_cast<std::size_t>(memberships));
   const int batches = (clusters + kMsmClusterBatch - 1) / kMsmClusterBatch;
-  m.cluster_lanes = arena.carve<Scalar>(static_cast<std::size_t>(batches) * kMsmClusterLaneFields<Dim> * kMsmClusterBatch);
+  m.cluster_lanes =
+      arena.carve<Scalar>(static_cast<std::size_t>(batches) * kMsmClusterLaneFields<Dim> * kMsmClusterBatch);
   if (arena.exhausted()) return Status::capacity_exceeded;
 
   for (int i = 0; i < n; ++i) {
@@ -247,7 +248,8 @@ Status build(Arena& arena, const MsmModelConfig<Dim, Scalar>& config, MsmModel<D
   }
   for (int k = 0; k < config.drivable_count; ++k) {
     const int id = config.drivable_ids[k];
-    if (m.drivable[id] == 0) m.mass[id] = static_cast<Scalar>(static_cast<double>(m.mass[id]) * config.driven_mass_factor);
+    if (m.drivable[id] == 0)
+      m.mass[id] = static_cast<Scalar>(static_cast<double>(m.mass[id]) * config.driven_mass_factor);
     m.drivable[id] = 1;
   }
 
@@ -263,7 +265,8 @@ Status build(Arena& arena, const MsmModelConfig<Dim, Scalar>& config, MsmModel<D
   // Transposed lists (particle -> clusters), by counting then filling.
   m.particle_cluster_begin[0] = 0;
   for (int i = 0; i < n; ++i) {
-    m.particle_cluster_begin[i + 1] = m.particle_cluster_begin[i] + static_cast<std::int32_t>(m.inverse_cluster_count[i]);
+    m.particle_cluster_begin[i + 1] =
+        m.particle_cluster_begin[i] + static_cast<std::int32_t>(m.inverse_cluster_count[i]);
   }
   for (int c = 0; c < clusters; ++c) {
     for (int k = m.cluster_begin[c]; k < m.cluster_begin[c + 1]; ++k) {
@@ -332,7 +335,8 @@ Status build(Arena& arena, const MsmModelConfig<Dim, Scalar>& config, MsmModel<D
     for (int lane = 0; lane < kMsmClusterBatch; ++lane) {
       const int c = b * kMsmClusterBatch + lane < clusters ? b * kMsmClusterBatch + lane : b * kMsmClusterBatch;
       int field = 0;
-      for (int d = 0; d < Dim; ++d) block[field++ * kMsmClusterBatch + lane] = m.cluster_rest_centroid[c](d) - m.rest_origin(d);
+      for (int d = 0; d < Dim; ++d)
+        block[field++ * kMsmClusterBatch + lane] = m.cluster_rest_centroid[c](d) - m.rest_origin(d);
       for (int e = 0; e < Dim * Dim; ++e) block[field++ * kMsmClusterBatch + lane] = m.cluster_aqq_inverse[c].data()[e];
       block[field * kMsmClusterBatch + lane] = m.cluster_inverse_mass[c];
     }
@@ -358,9 +362,10 @@ Status msm_model_init(Arena& arena, const MsmModelConfig<Dim, Scalar>& config, M
   return build(arena, config, model);
 }
 
-#define PLIANT_INSTANTIATE_MSM_MODEL(DIM, SCALAR)                                                   \
+#define PLIANT_INSTANTIATE_MSM_MODEL(DIM, SCALAR)                                                          \
   template std::size_t msm_model_workspace_size<DIM, SCALAR>(const MsmModelConfig<DIM, SCALAR>&) noexcept; \
-  template Status msm_model_init<DIM, SCALAR>(Arena&, const MsmModelConfig<DIM, SCALAR>&, MsmModel<DIM, SCALAR>&) noexcept;
+  template Status msm_model_init<DIM, SCALAR>(Arena&, const MsmModelConfig<DIM, SCALAR>&,                  \
+                                              MsmModel<DIM, SCALAR>&) noexcept;
 PLIANT_INSTANTIATE_MSM_MODEL(2, float)
 PLIANT_INSTANTIATE_MSM_MODEL(2, double)
 PLIANT_INSTANTIATE_MSM_MODEL(3, float)

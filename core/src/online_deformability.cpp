@@ -42,7 +42,8 @@ Status online_deformability_init(Arena& arena, const MsmModel<Dim, Scalar>& mode
 }
 
 template <int Dim, typename Scalar>
-void online_deformability_reset(const MsmModel<Dim, Scalar>& model, OnlineDeformability<Dim, Scalar>& estimator) noexcept {
+void online_deformability_reset(const MsmModel<Dim, Scalar>& model,
+                                OnlineDeformability<Dim, Scalar>& estimator) noexcept {
   PLIANT_ASSERT(estimator.initialized());
   for (int c = 0; c < estimator.candidates; ++c) {
     msm_state_reset(model, estimator.states[c]);
@@ -116,20 +117,18 @@ OnlineDeformabilityEstimate online_deformability_estimate(const OnlineDeformabil
   return out;
 }
 
-#define PLIANT_INSTANTIATE_ONLINE(DIM, SCALAR)                                                                   \
-  template std::size_t online_deformability_workspace_size<DIM, SCALAR>(const MsmModel<DIM, SCALAR>&,           \
-                                                                        const OnlineDeformabilityConfig&) noexcept; \
-  template Status online_deformability_init<DIM, SCALAR>(Arena&, const MsmModel<DIM, SCALAR>&,                  \
-                                                         const MsmParams<DIM, SCALAR>&,                           \
-                                                         const OnlineDeformabilityConfig&,                        \
-                                                         OnlineDeformability<DIM, SCALAR>&) noexcept;              \
-  template void online_deformability_reset<DIM, SCALAR>(const MsmModel<DIM, SCALAR>&,                            \
-                                                        OnlineDeformability<DIM, SCALAR>&) noexcept;               \
-  template Status online_deformability_update<DIM, SCALAR>(const MsmModel<DIM, SCALAR>&,                         \
-                                                           OnlineDeformability<DIM, SCALAR>&, SCALAR,             \
-                                                           const MsmDrivenTargets<DIM, SCALAR>&,                  \
-                                                           const Eigen::Matrix<SCALAR, DIM, 1>*) noexcept;        \
-  template OnlineDeformabilityEstimate online_deformability_estimate<DIM, SCALAR>(                               \
+#define PLIANT_INSTANTIATE_ONLINE(DIM, SCALAR)                                                                       \
+  template std::size_t online_deformability_workspace_size<DIM, SCALAR>(const MsmModel<DIM, SCALAR>&,                \
+                                                                        const OnlineDeformabilityConfig&) noexcept;  \
+  template Status online_deformability_init<DIM, SCALAR>(                                                            \
+      Arena&, const MsmModel<DIM, SCALAR>&, const MsmParams<DIM, SCALAR>&, const OnlineDeformabilityConfig&,         \
+      OnlineDeformability<DIM, SCALAR>&) noexcept;                                                                   \
+  template void online_deformability_reset<DIM, SCALAR>(const MsmModel<DIM, SCALAR>&,                                \
+                                                        OnlineDeformability<DIM, SCALAR>&) noexcept;                 \
+  template Status online_deformability_update<DIM, SCALAR>(                                                          \
+      const MsmModel<DIM, SCALAR>&, OnlineDeformability<DIM, SCALAR>&, SCALAR, const MsmDrivenTargets<DIM, SCALAR>&, \
+      const Eigen::Matrix<SCALAR, DIM, 1>*) noexcept;                                                                \
+  template OnlineDeformabilityEstimate online_deformability_estimate<DIM, SCALAR>(                                   \
       const OnlineDeformability<DIM, SCALAR>&) noexcept;
 PLIANT_INSTANTIATE_ONLINE(2, float)
 PLIANT_INSTANTIATE_ONLINE(2, double)

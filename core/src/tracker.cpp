@@ -362,8 +362,8 @@ Status tracker_update(const MsmModel<Dim, Scalar>& model, Tracker<Dim, Scalar>& 
   return Status::ok;
 }
 
-#define PLIANT_INSTANTIATE_TRACKER(DIM, SCALAR)                                                                 \
-  template std::size_t tracker_workspace_size<DIM, SCALAR>(const MsmModel<DIM, SCALAR>&,                        \
+#define PLIANT_INSTANTIATE_TRACKER(DIM, SCALAR)                                                                  \
+  template std::size_t tracker_workspace_size<DIM, SCALAR>(const MsmModel<DIM, SCALAR>&,                         \
                                                            const TrackerConfig&) noexcept;                       \
   template Status tracker_init<DIM, SCALAR>(Arena&, const MsmModel<DIM, SCALAR>&, const MsmParams<DIM, SCALAR>&, \
                                             const TrackerConfig&, Tracker<DIM, SCALAR>&) noexcept;               \

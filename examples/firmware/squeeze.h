@@ -19,18 +19,17 @@
 #define SQUEEZE_PARTICLES (SQUEEZE_NX * SQUEEZE_NY * SQUEEZE_NZ)
 #define SQUEEZE_SPACING_M 0.010
 /** Rest extent along x: the jaw opening at first contact, m. */
-#define SQUEEZE_EXTENT_M (SQUEEZE_SPACING_M * (double) (SQUEEZE_NX - 1U))
+#define SQUEEZE_EXTENT_M (SQUEEZE_SPACING_M * (double)(SQUEEZE_NX - 1U))
 /** Particles touching the jaws: both x faces. */
 #define SQUEEZE_JAW_PARTICLES (2U * SQUEEZE_NY * SQUEEZE_NZ)
 /** Fastest jaw motion, m/s. */
 #define SQUEEZE_JAW_SPEED_M_PER_S 0.002
 
-typedef struct squeeze_s
-{
-    float rest[SQUEEZE_PARTICLES * 3U]; /**< rest positions, m, particle-major */
-    double width_m;                     /**< jaw opening now */
-    double target_width_m;              /**< commanded opening */
-    uint32_t noise_state;               /**< xorshift32 state */
+typedef struct squeeze_s {
+  float rest[SQUEEZE_PARTICLES * 3U]; /**< rest positions, m, particle-major */
+  double width_m;                     /**< jaw opening now */
+  double target_width_m;              /**< commanded opening */
+  uint32_t noise_state;               /**< xorshift32 state */
 } squeeze_t;
 
 /** Rest shape, jaws open at `width_m`, no motion commanded. */

@@ -39,14 +39,13 @@ void PendSV_Handler(void) __attribute__((weak, alias("Default_Handler")));
 void SysTick_Handler(void) __attribute__((weak, alias("Default_Handler")));
 
 /* System control block. */
-#define SCB_VTOR (*(volatile uint32_t*) 0xE000ED08U)
-#define SCB_CPACR (*(volatile uint32_t*) 0xE000ED88U)
+#define SCB_VTOR (*(volatile uint32_t*)0xE000ED08U)
+#define SCB_CPACR (*(volatile uint32_t*)0xE000ED88U)
 #define CPACR_CP10_CP11_FULL (0xFU << 20)
 
-typedef struct vector_table_s
-{
-    uint32_t* initial_stack;
-    vector_t handlers[15];
+typedef struct vector_table_s {
+  uint32_t* initial_stack;
+  vector_t handlers[15];
 } vector_table_t;
 
 __attribute__((section(".isr_vector"), used)) const vector_table_t g_vector_table = {
@@ -67,29 +66,28 @@ __attribute__((section(".isr_vector"), used)) const vector_table_t g_vector_tabl
     },
 };
 
-void Reset_Handler(void)
-{
-    /* The FPU first: compiled for -mfloat-abi=hard, any later code may use FPU registers, and
-     * an FPU instruction with CP10/CP11 disabled is a UsageFault. */
-    SCB_CPACR |= CPACR_CP10_CP11_FULL;
-    __asm volatile("dsb\n\tisb" ::: "memory");
+void Reset_Handler(void) {
+  /* The FPU first: compiled for -mfloat-abi=hard, any later code may use FPU registers, and
+   * an FPU instruction with CP10/CP11 disabled is a UsageFault. */
+  SCB_CPACR |= CPACR_CP10_CP11_FULL;
+  __asm volatile("dsb\n\tisb" ::: "memory");
 
-    const uint32_t* source = &__data_load__;
-    for (uint32_t* word = &__data_start__; word < &__data_end__; ++word) {
-        *word = *source++;
-    }
-    for (uint32_t* word = &__bss_start__; word < &__bss_end__; ++word) {
-        *word = 0U;
-    }
-    SCB_VTOR = (uint32_t) (uintptr_t) &g_vector_table;
-    __asm volatile("dsb\n\tisb" ::: "memory");
+  const uint32_t* source = &__data_load__;
+  for (uint32_t* word = &__data_start__; word < &__data_end__; ++word) {
+    *word = *source++;
+  }
+  for (uint32_t* word = &__bss_start__; word < &__bss_end__; ++word) {
+    *word = 0U;
+  }
+  SCB_VTOR = (uint32_t)(uintptr_t)&g_vector_table;
+  __asm volatile("dsb\n\tisb" ::: "memory");
 
-    for (vector_t* ctor = __preinit_array_start; ctor < __preinit_array_end; ++ctor) {
-        (*ctor)();
-    }
-    for (vector_t* ctor = __init_array_start; ctor < __init_array_end; ++ctor) {
-        (*ctor)();
-    }
-    (void) main();
-    board_fail_safe(); /* main never returns; if it did, nothing may keep running */
+  for (vector_t* ctor = __preinit_array_start; ctor < __preinit_array_end; ++ctor) {
+    (*ctor)();
+  }
+  for (vector_t* ctor = __init_array_start; ctor < __init_array_end; ++ctor) {
+    (*ctor)();
+  }
+  (void)main();
+  board_fail_safe(); /* main never returns; if it did, nothing may keep running */
 }

@@ -18,9 +18,8 @@ void* _sbrk(ptrdiff_t increment);
 
 void abort(void) { board_fail_safe(); }
 
-void* _sbrk(ptrdiff_t increment)
-{
-    (void) increment;
-    errno = ENOMEM;
-    return (void*) (intptr_t) -1;
+void* _sbrk(ptrdiff_t increment) {
+  (void)increment;
+  errno = ENOMEM;
+  return (void*)(intptr_t)-1;
 }

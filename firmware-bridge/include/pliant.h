@@ -149,44 +149,42 @@ uint32_t pliant_abi_version(void);
 /** The layout a caller was compiled with: sizes of every struct that crosses this interface.
  *  Filled in by pliant_config_init_default (an inline function, so it measures the caller's
  *  header) and checked by pliant_workspace_size and pliant_init. */
-typedef struct pliant_abi_s
-{
-    uint32_t version;          /**< PLIANT_ABI_VERSION */
-    uint32_t config_size;      /**< sizeof(pliant_config_t) */
-    uint32_t guard_input_size; /**< sizeof(pliant_guard_input_t) */
-    uint32_t verdict_size;     /**< sizeof(pliant_verdict_t) */
-    uint32_t estimate_size;    /**< sizeof(pliant_estimate_t) */
-    uint32_t deformation_size; /**< sizeof(pliant_deformation_t) */
-    uint32_t counters_size;    /**< sizeof(pliant_counters_t) */
-    uint32_t info_size;        /**< sizeof(pliant_info_t) */
+typedef struct pliant_abi_s {
+  uint32_t version;          /**< PLIANT_ABI_VERSION */
+  uint32_t config_size;      /**< sizeof(pliant_config_t) */
+  uint32_t guard_input_size; /**< sizeof(pliant_guard_input_t) */
+  uint32_t verdict_size;     /**< sizeof(pliant_verdict_t) */
+  uint32_t estimate_size;    /**< sizeof(pliant_estimate_t) */
+  uint32_t deformation_size; /**< sizeof(pliant_deformation_t) */
+  uint32_t counters_size;    /**< sizeof(pliant_counters_t) */
+  uint32_t info_size;        /**< sizeof(pliant_info_t) */
 } pliant_abi_t;
 
 /* ============================================================================================
  * Status codes
  * ========================================================================================== */
 
-typedef enum pliant_status_e
-{
-    PLIANT_OK = 0,
-    /** Not an error: the call did its work but no usable observation was available (the
-     *  tracker predicted the frame from the model; the estimator stepped without scoring).
-     *  Counted in the component's counters. */
-    PLIANT_NO_OBSERVATIONS = 1,
-    PLIANT_ERROR_NULL_ARGUMENT = 2,    /**< a required pointer is NULL */
-    PLIANT_ERROR_INVALID_ARGUMENT = 3, /**< a size, count, id, option or range is wrong */
-    PLIANT_ERROR_NON_FINITE = 4,       /**< NaN or infinity where a finite number is required */
-    PLIANT_ERROR_STAMP_ORDER = 5,      /**< a frame stamp not after the previous frame's */
-    PLIANT_ERROR_ABI_MISMATCH = 6,     /**< the caller was built against another pliant.h */
-    PLIANT_ERROR_MEMORY_TOO_SMALL = 7, /**< the block is smaller than pliant_workspace_size */
-    PLIANT_ERROR_NOT_INITIALIZED = 8,  /**< the instance was never initialised, or init failed */
-    PLIANT_ERROR_BAD_STATE = 9,        /**< the call is out of order (e.g. step with no frame) */
-    PLIANT_ERROR_DISABLED = 10,        /**< the component (estimator, guard) is disabled */
-    PLIANT_ERROR_INVALID_MASS = 11,    /**< a particle mass is not finite and > 0 */
-    PLIANT_ERROR_DUPLICATE_REST = 12,  /**< two particles share a rest position */
-    PLIANT_ERROR_DEGENERATE_CLUSTER = 13, /**< a cluster has a single member */
-    PLIANT_ERROR_NO_FREE_PARTICLES = 14,  /**< every particle is fixed or drivable */
-    PLIANT_ERROR_INTERNAL = 15,        /**< an unexpected result inside the library (a bug) */
-    PLIANT_STATUS_COUNT = 16
+typedef enum pliant_status_e {
+  PLIANT_OK = 0,
+  /** Not an error: the call did its work but no usable observation was available (the
+   *  tracker predicted the frame from the model; the estimator stepped without scoring).
+   *  Counted in the component's counters. */
+  PLIANT_NO_OBSERVATIONS = 1,
+  PLIANT_ERROR_NULL_ARGUMENT = 2,       /**< a required pointer is NULL */
+  PLIANT_ERROR_INVALID_ARGUMENT = 3,    /**< a size, count, id, option or range is wrong */
+  PLIANT_ERROR_NON_FINITE = 4,          /**< NaN or infinity where a finite number is required */
+  PLIANT_ERROR_STAMP_ORDER = 5,         /**< a frame stamp not after the previous frame's */
+  PLIANT_ERROR_ABI_MISMATCH = 6,        /**< the caller was built against another pliant.h */
+  PLIANT_ERROR_MEMORY_TOO_SMALL = 7,    /**< the block is smaller than pliant_workspace_size */
+  PLIANT_ERROR_NOT_INITIALIZED = 8,     /**< the instance was never initialised, or init failed */
+  PLIANT_ERROR_BAD_STATE = 9,           /**< the call is out of order (e.g. step with no frame) */
+  PLIANT_ERROR_DISABLED = 10,           /**< the component (estimator, guard) is disabled */
+  PLIANT_ERROR_INVALID_MASS = 11,       /**< a particle mass is not finite and > 0 */
+  PLIANT_ERROR_DUPLICATE_REST = 12,     /**< two particles share a rest position */
+  PLIANT_ERROR_DEGENERATE_CLUSTER = 13, /**< a cluster has a single member */
+  PLIANT_ERROR_NO_FREE_PARTICLES = 14,  /**< every particle is fixed or drivable */
+  PLIANT_ERROR_INTERNAL = 15,           /**< an unexpected result inside the library (a bug) */
+  PLIANT_STATUS_COUNT = 16
 } pliant_status_t;
 
 /** True for a status that means the call was refused (nothing changed). */
@@ -211,44 +209,40 @@ void pliant_set_assert_handler(pliant_assert_handler_t handler);
 #define PLIANT_CLUSTERS_K_NEAREST 1U   /**< per particle: itself and its k nearest neighbours */
 #define PLIANT_CLUSTERS_GRID_BLOCKS 2U /**< every block window of a particle grid, stride 1 */
 
-typedef struct pliant_cluster_config_s
-{
-    uint8_t layout;         /**< PLIANT_CLUSTERS_*; default RADIUS (the project's MSM default) */
-    double radius_factor;   /**< RADIUS: > 0, default 1.5 */
-    int32_t k;              /**< K_NEAREST: 1..64, default 8 */
-    /** GRID_BLOCKS: id = (layer * grid_rows + row) * grid_cols + col and
-     *  grid_cols * grid_rows * grid_layers == particle_count; blocks default 3 x 2 x 1. */
-    int32_t grid_cols, grid_rows, grid_layers;
-    int32_t block_cols, block_rows, block_layers;
+typedef struct pliant_cluster_config_s {
+  uint8_t layout;       /**< PLIANT_CLUSTERS_*; default RADIUS (the project's MSM default) */
+  double radius_factor; /**< RADIUS: > 0, default 1.5 */
+  int32_t k;            /**< K_NEAREST: 1..64, default 8 */
+  /** GRID_BLOCKS: id = (layer * grid_rows + row) * grid_cols + col and
+   *  grid_cols * grid_rows * grid_layers == particle_count; blocks default 3 x 2 x 1. */
+  int32_t grid_cols, grid_rows, grid_layers;
+  int32_t block_cols, block_rows, block_layers;
 } pliant_cluster_config_t;
 
-typedef struct pliant_msm_config_s
-{
-    double msm_alpha;          /**< (0, 1], default 1 */
-    double msm_beta;           /**< [0, 1]: the tracker's initial prior, default 0.5 */
-    double gravity[3];         /**< m/s^2 in the object frame (z ignored in 2D), default 0 */
-    double velocity_damping;   /**< 1/s, >= 0, default 0 */
-    double driven_mass_factor; /**< mass multiplier of drivable particles, > 0, default 1 */
+typedef struct pliant_msm_config_s {
+  double msm_alpha;          /**< (0, 1], default 1 */
+  double msm_beta;           /**< [0, 1]: the tracker's initial prior, default 0.5 */
+  double gravity[3];         /**< m/s^2 in the object frame (z ignored in 2D), default 0 */
+  double velocity_damping;   /**< 1/s, >= 0, default 0 */
+  double driven_mass_factor; /**< mass multiplier of drivable particles, > 0, default 1 */
 } pliant_msm_config_t;
 
-typedef struct pliant_tracker_config_s
-{
-    double tukey_c;                /**< > 0, default 4.685 (robust-scale units) */
-    double min_residual_scale;     /**< m, >= 0; set to the observation noise sd; 0: 1e-3 x spacing */
-    double observation_gain;       /**< (0, 1], default 1 */
-    int32_t projection_iterations; /**< 0..64, default 2 */
-    int32_t max_unobserved_frames; /**< >= 1, default 30: frames without observation before "lost" */
+typedef struct pliant_tracker_config_s {
+  double tukey_c;                /**< > 0, default 4.685 (robust-scale units) */
+  double min_residual_scale;     /**< m, >= 0; set to the observation noise sd; 0: 1e-3 x spacing */
+  double observation_gain;       /**< (0, 1], default 1 */
+  int32_t projection_iterations; /**< 0..64, default 2 */
+  int32_t max_unobserved_frames; /**< >= 1, default 30: frames without observation before "lost" */
 } pliant_tracker_config_t;
 
-typedef struct pliant_estimator_config_s
-{
-    bool enabled;       /**< default true; false: no estimator memory, update_estimate refused */
-    int32_t candidates; /**< K >= 3 msm_beta candidates on [0, 1], default 11 */
-    double forgetting;  /**< (0, 1] per-frame weight of past residuals, default 1 */
-    /** true (default): after each estimate whose sd is finite and <= feed_back_max_std, the
-     *  tracker's prior msm_beta is set to the estimate. */
-    bool feed_back_beta;
-    double feed_back_max_std; /**< default 0.1 */
+typedef struct pliant_estimator_config_s {
+  bool enabled;       /**< default true; false: no estimator memory, update_estimate refused */
+  int32_t candidates; /**< K >= 3 msm_beta candidates on [0, 1], default 11 */
+  double forgetting;  /**< (0, 1] per-frame weight of past residuals, default 1 */
+  /** true (default): after each estimate whose sd is finite and <= feed_back_max_std, the
+   *  tracker's prior msm_beta is set to the estimate. */
+  bool feed_back_beta;
+  double feed_back_max_std; /**< default 0.1 */
 } pliant_estimator_config_t;
 
 /* Verdicts (pliant_verdict_t.verdict, fault_verdict[], uncertain_estimate_verdict). */
@@ -275,107 +269,105 @@ typedef struct pliant_estimator_config_s
 /** The grasp guard: the object's limits, the jaws, and how faults are handled. Every field has
  *  the default pliant_config_init_default gives; see the core's grasp_guard.hpp for the
  *  algorithm. Widths are pad-to-pad openings; closure = contact width - width. */
-typedef struct pliant_guard_config_s
-{
-    bool enabled; /**< default true; false: no guard memory, guard calls refused */
+typedef struct pliant_guard_config_s {
+  bool enabled; /**< default true; false: no guard memory, guard calls refused */
 
-    /* --- the object's limits ------------------------------------------------------------- */
-    double max_strain;        /**< largest cluster principal strain, > 0 (+inf: none); 0.1 */
-    double max_indentation_m; /**< closure limit, > 0; default +inf (none) */
-    double max_force_n;       /**< hard grip-force limit, finite > 0; default 10 */
-    double nominal_force_n;   /**< allowed force without slip, (0, max]; NaN (default): max */
+  /* --- the object's limits ------------------------------------------------------------- */
+  double max_strain;        /**< largest cluster principal strain, > 0 (+inf: none); 0.1 */
+  double max_indentation_m; /**< closure limit, > 0; default +inf (none) */
+  double max_force_n;       /**< hard grip-force limit, finite > 0; default 10 */
+  double nominal_force_n;   /**< allowed force without slip, (0, max]; NaN (default): max */
 
-    /* --- jaws ------------------------------------------------------------------------------ */
-    /** Squeeze direction in the object frame, jaw A -> jaw B; normalised at init; required
-     *  (default all zero is refused). z is ignored in 2D. */
-    double squeeze_axis[3];
-    /** Particles touching each jaw at first contact (read during init only). NULL / 0: those
-     *  within contact_band x spacing of the extreme rest positions along the axis. */
-    const int32_t* jaw_a_ids;
-    uint32_t jaw_a_count;
-    const int32_t* jaw_b_ids;
-    uint32_t jaw_b_count;
-    double contact_band; /**< default 0.25 */
+  /* --- jaws ------------------------------------------------------------------------------ */
+  /** Squeeze direction in the object frame, jaw A -> jaw B; normalised at init; required
+   *  (default all zero is refused). z is ignored in 2D. */
+  double squeeze_axis[3];
+  /** Particles touching each jaw at first contact (read during init only). NULL / 0: those
+   *  within contact_band x spacing of the extreme rest positions along the axis. */
+  const int32_t* jaw_a_ids;
+  uint32_t jaw_a_count;
+  const int32_t* jaw_b_ids;
+  uint32_t jaw_b_count;
+  double contact_band; /**< default 0.25 */
 
-    /* --- contact ------------------------------------------------------------------------- */
-    double contact_width_m;         /**< width at first contact; NaN (default): detected by force */
-    double contact_force_n;         /**< detection force, default 0.5 */
-    double contact_width_tolerance; /**< detected width vs model extent, fraction; default 0.5 */
-    double max_width_m;             /**< widths outside [0, max] are invalid; default 0.5 */
+  /* --- contact ------------------------------------------------------------------------- */
+  double contact_width_m;         /**< width at first contact; NaN (default): detected by force */
+  double contact_force_n;         /**< detection force, default 0.5 */
+  double contact_width_tolerance; /**< detected width vs model extent, fraction; default 0.5 */
+  double max_width_m;             /**< widths outside [0, max] are invalid; default 0.5 */
 
-    /* --- grip force ---------------------------------------------------------------------- */
-    uint8_t force_source;        /**< PLIANT_FORCE_*; default SENSOR */
-    double current_gain_n_per_a; /**< MOTOR_CURRENT: finite > 0 */
-    double current_offset_a;
+  /* --- grip force ---------------------------------------------------------------------- */
+  uint8_t force_source;        /**< PLIANT_FORCE_*; default SENSOR */
+  double current_gain_n_per_a; /**< MOTOR_CURRENT: finite > 0 */
+  double current_offset_a;
 
-    /* --- freshness, s ------------------------------------------------------------------- */
-    double gripper_timeout_s;      /**< default 0.02 */
-    double wrench_timeout_s;       /**< default 0.02 */
-    double camera_timeout_s;       /**< default 0.1 */
-    double estimate_timeout_s;     /**< default 0.5 */
-    double cycle_timeout_s;        /**< longest gap between guard cycles, default 0.02 */
-    double clock_tolerance_s;      /**< how far a stamp may lie in the future, default 0.002 */
-    int32_t wrench_frozen_samples; /**< bit-identical wrench samples meaning frozen; 0 (default): off */
+  /* --- freshness, s ------------------------------------------------------------------- */
+  double gripper_timeout_s;      /**< default 0.02 */
+  double wrench_timeout_s;       /**< default 0.02 */
+  double camera_timeout_s;       /**< default 0.1 */
+  double estimate_timeout_s;     /**< default 0.5 */
+  double cycle_timeout_s;        /**< longest gap between guard cycles, default 0.02 */
+  double clock_tolerance_s;      /**< how far a stamp may lie in the future, default 0.002 */
+  int32_t wrench_frozen_samples; /**< bit-identical wrench samples meaning frozen; 0 (default): off */
 
-    /* --- status words: set bits are faults -------------------------------------------- */
-    uint32_t gripper_fault_mask; /**< default 0xffffffff */
-    uint32_t wrench_fault_mask;  /**< default 0x18fe (ATI NETCANOEM status bits 1-7, 11, 12) */
-    uint32_t camera_fault_mask;  /**< default 0xffffffff */
+  /* --- status words: set bits are faults -------------------------------------------- */
+  uint32_t gripper_fault_mask; /**< default 0xffffffff */
+  uint32_t wrench_fault_mask;  /**< default 0x18fe (ATI NETCANOEM status bits 1-7, 11, 12) */
+  uint32_t camera_fault_mask;  /**< default 0xffffffff */
 
-    /* --- verdicts and hysteresis ------------------------------------------------------- */
-    /** Verdict of a fault per PLIANT_SOURCE_* (LIMIT or STOP). Defaults: gripper, wrench and
-     *  clock STOP; camera and estimate LIMIT. */
-    uint8_t fault_verdict[PLIANT_GUARD_SOURCE_COUNT];
-    uint8_t uncertain_estimate_verdict; /**< default OK (reported only) */
-    uint8_t exceeded_stop_action;       /**< stop for an exceeded limit; default OPEN */
-    uint8_t fault_stop_action;          /**< stop for a fault; default FREEZE */
-    bool latch_stop;                    /**< STOP persists until acknowledged; default false */
-    double hysteresis_margin;           /**< [0, 1), default 0.05 */
-    int32_t clear_samples;              /**< >= 1, default 5 */
-    double stop_overshoot;              /**< >= 0, default 0.1: STOP at limit x (1 + this) */
+  /* --- verdicts and hysteresis ------------------------------------------------------- */
+  /** Verdict of a fault per PLIANT_SOURCE_* (LIMIT or STOP). Defaults: gripper, wrench and
+   *  clock STOP; camera and estimate LIMIT. */
+  uint8_t fault_verdict[PLIANT_GUARD_SOURCE_COUNT];
+  uint8_t uncertain_estimate_verdict; /**< default OK (reported only) */
+  uint8_t exceeded_stop_action;       /**< stop for an exceeded limit; default OPEN */
+  uint8_t fault_stop_action;          /**< stop for a fault; default FREEZE */
+  bool latch_stop;                    /**< STOP persists until acknowledged; default false */
+  double hysteresis_margin;           /**< [0, 1), default 0.05 */
+  int32_t clear_samples;              /**< >= 1, default 5 */
+  double stop_overshoot;              /**< >= 0, default 0.1: STOP at limit x (1 + this) */
 
-    /* --- the estimate --------------------------------------------------------------------- */
-    double confidence_k; /**< interval half-width in sd, >= 0, default 2 */
-    double max_beta_std; /**< > 0, default 0.15 */
+  /* --- the estimate --------------------------------------------------------------------- */
+  double confidence_k; /**< interval half-width in sd, >= 0, default 2 */
+  double max_beta_std; /**< > 0, default 0.15 */
 
-    /* --- slip cue (PR2 gripper controller) -------------------------------------------- */
-    double slip_cutoff_hz;        /**< default 5 */
-    double slip_ratio;            /**< default 0.007 */
-    double slip_floor_n;          /**< default 0.048 */
-    double slip_ceiling_n;        /**< default 0.2 */
-    double slip_force_rate_per_s; /**< default 2 */
+  /* --- slip cue (PR2 gripper controller) -------------------------------------------- */
+  double slip_cutoff_hz;        /**< default 5 */
+  double slip_ratio;            /**< default 0.007 */
+  double slip_floor_n;          /**< default 0.048 */
+  double slip_ceiling_n;        /**< default 0.2 */
+  double slip_force_rate_per_s; /**< default 2 */
 
-    /* --- force model ------------------------------------------------------------------- */
-    double force_fit_spacing_m;       /**< default 1e-4 */
-    double force_fit_forgetting;      /**< (0, 1], default 0.7 */
-    double force_model_min_closure_m; /**< default 2e-4 */
+  /* --- force model ------------------------------------------------------------------- */
+  double force_fit_spacing_m;       /**< default 1e-4 */
+  double force_fit_forgetting;      /**< (0, 1], default 0.7 */
+  double force_model_min_closure_m; /**< default 2e-4 */
 
-    /* --- prediction table (built by pliant_init: this is what makes init slow) -------- */
-    int32_t prediction_beta_points;    /**< >= 2, default 11 */
-    int32_t prediction_closure_points; /**< >= 2, default 32 */
-    int32_t prediction_refine_steps;   /**< >= 1, default 8 */
-    double prediction_max_closure_m;   /**< NaN (default): from max_strain and the extent */
-    int32_t relax_max_iterations;      /**< >= 1, default 3000 */
-    double relax_tolerance;            /**< x spacing, default 1e-6 */
+  /* --- prediction table (built by pliant_init: this is what makes init slow) -------- */
+  int32_t prediction_beta_points;    /**< >= 2, default 11 */
+  int32_t prediction_closure_points; /**< >= 2, default 32 */
+  int32_t prediction_refine_steps;   /**< >= 1, default 8 */
+  double prediction_max_closure_m;   /**< NaN (default): from max_strain and the extent */
+  int32_t relax_max_iterations;      /**< >= 1, default 3000 */
+  double relax_tolerance;            /**< x spacing, default 1e-6 */
 } pliant_guard_config_t;
 
 /** The object and every component's options. Arrays are read during pliant_workspace_size and
  *  pliant_init only (copied into the block); the caller may free them afterwards. */
-typedef struct pliant_config_s
-{
-    pliant_abi_t abi;              /**< set by pliant_config_init_default; do not touch */
-    uint32_t dim;                  /**< 2 or 3 (default 3) */
-    uint32_t particle_count;       /**< N >= 2 */
-    const float* rest_positions;   /**< [N * dim] m, the undeformed object (required) */
-    const float* masses;           /**< [N] kg, finite > 0; NULL (default): 1 for all */
-    const uint8_t* fixed;          /**< [N] 1 = pinned at rest; NULL (default): none */
-    const int32_t* drivable_ids;   /**< particles the tool contact may drive; NULL / 0: none */
-    uint32_t drivable_count;       /**< <= N */
-    pliant_cluster_config_t clusters;
-    pliant_msm_config_t msm;
-    pliant_tracker_config_t tracker;
-    pliant_estimator_config_t estimator;
-    pliant_guard_config_t guard;
+typedef struct pliant_config_s {
+  pliant_abi_t abi;            /**< set by pliant_config_init_default; do not touch */
+  uint32_t dim;                /**< 2 or 3 (default 3) */
+  uint32_t particle_count;     /**< N >= 2 */
+  const float* rest_positions; /**< [N * dim] m, the undeformed object (required) */
+  const float* masses;         /**< [N] kg, finite > 0; NULL (default): 1 for all */
+  const uint8_t* fixed;        /**< [N] 1 = pinned at rest; NULL (default): none */
+  const int32_t* drivable_ids; /**< particles the tool contact may drive; NULL / 0: none */
+  uint32_t drivable_count;     /**< <= N */
+  pliant_cluster_config_t clusters;
+  pliant_msm_config_t msm;
+  pliant_tracker_config_t tracker;
+  pliant_estimator_config_t estimator;
+  pliant_guard_config_t guard;
 } pliant_config_t;
 
 /** Fills *config with the defaults documented above and the ABI stamp of the caller's
@@ -387,66 +379,61 @@ pliant_status_t pliant_config_init_default_checked(pliant_config_t* config, cons
  * Per-cycle guard input and output
  * ========================================================================================== */
 
-typedef struct pliant_gripper_sample_s
-{
-    double stamp_s;       /**< the sample's time */
-    double width_m;       /**< pad-to-pad opening */
-    double force_n;       /**< grip force (PLIANT_FORCE_SENSOR) */
-    double current_a;     /**< motor current (PLIANT_FORCE_MOTOR_CURRENT) */
-    uint32_t status_bits; /**< driver status word; bits in gripper_fault_mask are faults */
-    bool valid;           /**< false: the driver has no good sample (a fault) */
-    bool bus_off;
-    bool timeout;         /**< the driver timed out reading the gripper */
+typedef struct pliant_gripper_sample_s {
+  double stamp_s;       /**< the sample's time */
+  double width_m;       /**< pad-to-pad opening */
+  double force_n;       /**< grip force (PLIANT_FORCE_SENSOR) */
+  double current_a;     /**< motor current (PLIANT_FORCE_MOTOR_CURRENT) */
+  uint32_t status_bits; /**< driver status word; bits in gripper_fault_mask are faults */
+  bool valid;           /**< false: the driver has no good sample (a fault) */
+  bool bus_off;
+  bool timeout; /**< the driver timed out reading the gripper */
 } pliant_gripper_sample_t;
 
-typedef struct pliant_wrench_sample_s
-{
-    double stamp_s;
-    double wrench[6]; /**< Fx Fy Fz (N), Tx Ty Tz (N m) in the sensor frame */
-    uint32_t status_bits;
-    bool valid;
-    bool bus_off;
-    bool timeout;
+typedef struct pliant_wrench_sample_s {
+  double stamp_s;
+  double wrench[6]; /**< Fx Fy Fz (N), Tx Ty Tz (N m) in the sensor frame */
+  uint32_t status_bits;
+  bool valid;
+  bool bus_off;
+  bool timeout;
 } pliant_wrench_sample_t;
 
 /* Where the guard takes a deformation or estimate sample from. */
 #define PLIANT_SOURCE_BRIDGE 0U /**< this instance's last tracked frame / last estimate (default) */
 #define PLIANT_SOURCE_CALLER 1U /**< the values in the input struct */
 
-typedef struct pliant_deformation_sample_s
-{
-    /** PLIANT_SOURCE_BRIDGE: stamp_s, strain and valid are taken from the last stepped frame
-     *  (its stamp, the strain measured on the tracked positions, valid when measured; no frame
-     *  yet: not valid, a camera fault); status_bits, bus_off and timeout are still the
-     *  caller's (the camera driver's flags). PLIANT_SOURCE_CALLER: all fields are the caller's. */
-    uint8_t source;
-    double stamp_s;       /**< capture time of the frame */
-    double strain;        /**< largest cluster principal strain, >= 0 */
-    uint32_t status_bits; /**< bits in camera_fault_mask are faults */
-    bool valid;
-    bool bus_off;
-    bool timeout;
+typedef struct pliant_deformation_sample_s {
+  /** PLIANT_SOURCE_BRIDGE: stamp_s, strain and valid are taken from the last stepped frame
+   *  (its stamp, the strain measured on the tracked positions, valid when measured; no frame
+   *  yet: not valid, a camera fault); status_bits, bus_off and timeout are still the
+   *  caller's (the camera driver's flags). PLIANT_SOURCE_CALLER: all fields are the caller's. */
+  uint8_t source;
+  double stamp_s;       /**< capture time of the frame */
+  double strain;        /**< largest cluster principal strain, >= 0 */
+  uint32_t status_bits; /**< bits in camera_fault_mask are faults */
+  bool valid;
+  bool bus_off;
+  bool timeout;
 } pliant_deformation_sample_t;
 
-typedef struct pliant_estimate_sample_s
-{
-    /** PLIANT_SOURCE_BRIDGE: the estimator's latest estimate (stamped with its frame; before
-     *  the first estimator frame, or with the estimator disabled: not valid, an estimate fault).
-     *  PLIANT_SOURCE_CALLER: the fields below. */
-    uint8_t source;
-    double stamp_s;
-    double msm_beta;     /**< [0, 1] */
-    double msm_beta_std; /**< >= 0; +inf: not yet identifiable (not a fault) */
-    bool valid;
+typedef struct pliant_estimate_sample_s {
+  /** PLIANT_SOURCE_BRIDGE: the estimator's latest estimate (stamped with its frame; before
+   *  the first estimator frame, or with the estimator disabled: not valid, an estimate fault).
+   *  PLIANT_SOURCE_CALLER: the fields below. */
+  uint8_t source;
+  double stamp_s;
+  double msm_beta;     /**< [0, 1] */
+  double msm_beta_std; /**< >= 0; +inf: not yet identifiable (not a fault) */
+  bool valid;
 } pliant_estimate_sample_t;
 
-typedef struct pliant_guard_input_s
-{
-    double now_s; /**< this cycle's time on the monotonic clock */
-    pliant_gripper_sample_t gripper;
-    pliant_wrench_sample_t wrench;
-    pliant_deformation_sample_t deformation;
-    pliant_estimate_sample_t estimate;
+typedef struct pliant_guard_input_s {
+  double now_s; /**< this cycle's time on the monotonic clock */
+  pliant_gripper_sample_t gripper;
+  pliant_wrench_sample_t wrench;
+  pliant_deformation_sample_t deformation;
+  pliant_estimate_sample_t estimate;
 } pliant_guard_input_t;
 
 /** Sets every time and value of *input to NaN, every flag to false, status words to 0 and both
@@ -462,45 +449,44 @@ pliant_status_t pliant_guard_input_init_checked(pliant_guard_input_t* input, siz
 #define PLIANT_REASON_INDENTATION_EXCEEDED 3U /**< stop: closure >= max_indentation_m x (1 + overshoot) */
 #define PLIANT_REASON_NOT_CONFIGURED 4U       /**< stop: no guard, or contact width contradicts the model */
 #define PLIANT_REASON_NAN_INPUT 5U
-#define PLIANT_REASON_INVALID_INPUT 6U        /**< valid false, out of range, stamp in future/backwards */
+#define PLIANT_REASON_INVALID_INPUT 6U /**< valid false, out of range, stamp in future/backwards */
 #define PLIANT_REASON_SENSOR_FAULT 7U
 #define PLIANT_REASON_BUS_OFF 8U
-#define PLIANT_REASON_TIMEOUT 9U              /**< driver timeout, or guard not called in cycle_timeout_s */
+#define PLIANT_REASON_TIMEOUT 9U /**< driver timeout, or guard not called in cycle_timeout_s */
 #define PLIANT_REASON_STALE_GRIPPER 10U
-#define PLIANT_REASON_STALE_WRENCH 11U        /**< also: frozen (bit-identical) wrench */
+#define PLIANT_REASON_STALE_WRENCH 11U /**< also: frozen (bit-identical) wrench */
 #define PLIANT_REASON_STALE_CAMERA 12U
 #define PLIANT_REASON_STALE_ESTIMATE 13U
-#define PLIANT_REASON_FORCE_LIMIT 14U         /**< limit: force >= allowed_force_n */
-#define PLIANT_REASON_STRAIN_LIMIT 15U        /**< limit: strain >= max_strain */
-#define PLIANT_REASON_INDENTATION_LIMIT 16U   /**< limit: closure >= max_indentation_m */
-#define PLIANT_REASON_PREDICTED_STRAIN 17U    /**< limit: closure >= the MSM-predicted safe closure */
-#define PLIANT_REASON_ESTIMATE_UNCERTAIN 18U  /**< msm_beta_std >= max_beta_std */
+#define PLIANT_REASON_FORCE_LIMIT 14U        /**< limit: force >= allowed_force_n */
+#define PLIANT_REASON_STRAIN_LIMIT 15U       /**< limit: strain >= max_strain */
+#define PLIANT_REASON_INDENTATION_LIMIT 16U  /**< limit: closure >= max_indentation_m */
+#define PLIANT_REASON_PREDICTED_STRAIN 17U   /**< limit: closure >= the MSM-predicted safe closure */
+#define PLIANT_REASON_ESTIMATE_UNCERTAIN 18U /**< msm_beta_std >= max_beta_std */
 #define PLIANT_REASON_COUNT 19U
 
 /** The guard's answer for one cycle. Doubles are NaN where not known (e.g. before contact). */
-typedef struct pliant_verdict_s
-{
-    uint8_t verdict;       /**< PLIANT_VERDICT_* */
-    uint8_t reason;        /**< dominant PLIANT_REASON_*; NONE when OK */
-    uint8_t stop_action;   /**< PLIANT_STOP_*: what STOP means this cycle */
-    uint8_t fault_sources; /**< bit (1 << PLIANT_SOURCE_*) per source with an active fault */
-    uint32_t reasons;      /**< bit (1 << reason) per active reason */
-    bool in_contact;
-    bool slip;                     /**< slip cue active this cycle */
-    double contact_width_m;
-    double closure_m;              /**< contact width - width, >= 0 (0 before contact) */
-    double force_n;                /**< grip force used this cycle */
-    double strain;                 /**< measured strain used this cycle */
-    double allowed_force_n;        /**< nominal, raised by slip, <= max_force_n */
-    double beta_low, beta_high;    /**< msm_beta interval of the prediction */
-    double predicted_strain;       /**< at the current closure, worst over the interval */
-    double strain_safe_closure_m;  /**< largest closure with predicted strain <= max_strain */
-    double force_safe_closure_m;   /**< closure where the predicted force reaches allowed_force_n */
-    double safe_closure_m;         /**< min of the above and max_indentation_m */
-    double safe_width_m;           /**< contact width - safe_closure_m: close no further */
-    double predicted_force_n;      /**< force predicted at safe_closure_m */
-    double stiffness_n_per_m;      /**< slope of the force model */
-    double slip_force_n;           /**< high-passed wrist force magnitude */
+typedef struct pliant_verdict_s {
+  uint8_t verdict;       /**< PLIANT_VERDICT_* */
+  uint8_t reason;        /**< dominant PLIANT_REASON_*; NONE when OK */
+  uint8_t stop_action;   /**< PLIANT_STOP_*: what STOP means this cycle */
+  uint8_t fault_sources; /**< bit (1 << PLIANT_SOURCE_*) per source with an active fault */
+  uint32_t reasons;      /**< bit (1 << reason) per active reason */
+  bool in_contact;
+  bool slip; /**< slip cue active this cycle */
+  double contact_width_m;
+  double closure_m;             /**< contact width - width, >= 0 (0 before contact) */
+  double force_n;               /**< grip force used this cycle */
+  double strain;                /**< measured strain used this cycle */
+  double allowed_force_n;       /**< nominal, raised by slip, <= max_force_n */
+  double beta_low, beta_high;   /**< msm_beta interval of the prediction */
+  double predicted_strain;      /**< at the current closure, worst over the interval */
+  double strain_safe_closure_m; /**< largest closure with predicted strain <= max_strain */
+  double force_safe_closure_m;  /**< closure where the predicted force reaches allowed_force_n */
+  double safe_closure_m;        /**< min of the above and max_indentation_m */
+  double safe_width_m;          /**< contact width - safe_closure_m: close no further */
+  double predicted_force_n;     /**< force predicted at safe_closure_m */
+  double stiffness_n_per_m;     /**< slope of the force model */
+  double slip_force_n;          /**< high-passed wrist force magnitude */
 } pliant_verdict_t;
 
 /* ============================================================================================
@@ -512,27 +498,25 @@ typedef struct pliant_verdict_s
 #define PLIANT_TRACK_PREDICTED 1U /**< no usable observation this frame: follows the model */
 #define PLIANT_TRACK_LOST 2U      /**< no usable observation for > max_unobserved_frames */
 
-typedef struct pliant_estimate_s
-{
-    double stamp_s;      /**< stamp of the last frame the estimator used; NaN before */
-    double msm_beta;     /**< [0, 1] */
-    double msm_beta_std; /**< +inf until the residual curve has a positive curvature */
-    double rms;          /**< rms residual of the best candidate, m */
-    uint32_t frames;     /**< frames the estimator used since init / reset */
-    bool unique_minimum; /**< the residual curve has one basin */
-    bool valid;          /**< frames > 0 and msm_beta_std finite */
-    bool fed_back;       /**< this estimate was fed to the tracker's prior */
-    double tracker_msm_beta; /**< the tracker's current prior msm_beta */
+typedef struct pliant_estimate_s {
+  double stamp_s;          /**< stamp of the last frame the estimator used; NaN before */
+  double msm_beta;         /**< [0, 1] */
+  double msm_beta_std;     /**< +inf until the residual curve has a positive curvature */
+  double rms;              /**< rms residual of the best candidate, m */
+  uint32_t frames;         /**< frames the estimator used since init / reset */
+  bool unique_minimum;     /**< the residual curve has one basin */
+  bool valid;              /**< frames > 0 and msm_beta_std finite */
+  bool fed_back;           /**< this estimate was fed to the tracker's prior */
+  double tracker_msm_beta; /**< the tracker's current prior msm_beta */
 } pliant_estimate_t;
 
-typedef struct pliant_deformation_s
-{
-    double stamp_s;             /**< the frame's stamp; NaN before the first frame */
-    double strain;              /**< largest cluster principal strain; NaN if not measured */
-    int32_t cluster;            /**< the cluster holding it, -1 if none */
-    int32_t clusters_measured;
-    int32_t clusters_skipped;   /**< clusters with a lost particle */
-    bool valid;                 /**< measured on the last frame */
+typedef struct pliant_deformation_s {
+  double stamp_s;  /**< the frame's stamp; NaN before the first frame */
+  double strain;   /**< largest cluster principal strain; NaN if not measured */
+  int32_t cluster; /**< the cluster holding it, -1 if none */
+  int32_t clusters_measured;
+  int32_t clusters_skipped; /**< clusters with a lost particle */
+  bool valid;               /**< measured on the last frame */
 } pliant_deformation_t;
 
 /* Counter ids of the telemetry counters message (docs/telemetry.md). */
@@ -573,34 +557,33 @@ typedef struct pliant_deformation_s
 
 /** Monotonic counters (wrap at 2^32), since pliant_init. Fields 1-15 are the telemetry
  *  counter ids; the rest are details. */
-typedef struct pliant_counters_s
-{
-    uint32_t tracker_frames;            /**< 1: frames the tracker accepted */
-    uint32_t tracker_frames_rejected;   /**< 2: frames the tracker refused */
-    uint32_t observations_used;         /**< 3: particle observations used with weight > 0 */
-    uint32_t outliers;                  /**< 4: finite observations given weight 0 */
-    uint32_t particles_lost;            /**< 5: transitions of a particle to lost */
-    uint32_t estimator_frames;          /**< 6: frames the estimator used */
-    uint32_t estimator_frames_rejected; /**< 7: frames the estimator refused */
-    uint32_t guard_cycles;              /**< 8 */
-    uint32_t guard_limit_cycles;        /**< 9 */
-    uint32_t guard_stop_cycles;         /**< 10 */
-    uint32_t guard_slip_cycles;         /**< 11 */
-    uint32_t guard_inputs_refused;      /**< 12: sum of guard_refused[] */
-    uint32_t guard_stale_cycles;        /**< 13: sum of guard_stale[] */
-    uint32_t telemetry_not_sent;        /**< 14: telemetry packets not emitted (no room) */
-    uint32_t calls_rejected;            /**< 15: calls refused with an error status */
-    /* details */
-    uint32_t tracker_unobserved;        /**< particle-frames without a finite observation */
-    uint32_t tracker_empty_frames;      /**< frames with no usable observation */
-    uint32_t estimator_empty_frames;    /**< estimator frames with no particle to score */
-    uint32_t estimator_frames_skipped;  /**< stepped frames never given to the estimator */
-    uint32_t frames_replaced;           /**< pushed frames overwritten before being stepped */
-    uint32_t strain_unmeasured;         /**< stepped frames whose strain could not be measured */
-    uint32_t guard_refused[PLIANT_GUARD_SOURCE_COUNT]; /**< per PLIANT_SOURCE_* */
-    uint32_t guard_stale[PLIANT_GUARD_SOURCE_COUNT];   /**< per PLIANT_SOURCE_* */
-    uint8_t last_rejected_status;       /**< pliant_status_t of the last refused call */
-    uint8_t last_rejected_call;         /**< PLIANT_CALL_* of the last refused call */
+typedef struct pliant_counters_s {
+  uint32_t tracker_frames;            /**< 1: frames the tracker accepted */
+  uint32_t tracker_frames_rejected;   /**< 2: frames the tracker refused */
+  uint32_t observations_used;         /**< 3: particle observations used with weight > 0 */
+  uint32_t outliers;                  /**< 4: finite observations given weight 0 */
+  uint32_t particles_lost;            /**< 5: transitions of a particle to lost */
+  uint32_t estimator_frames;          /**< 6: frames the estimator used */
+  uint32_t estimator_frames_rejected; /**< 7: frames the estimator refused */
+  uint32_t guard_cycles;              /**< 8 */
+  uint32_t guard_limit_cycles;        /**< 9 */
+  uint32_t guard_stop_cycles;         /**< 10 */
+  uint32_t guard_slip_cycles;         /**< 11 */
+  uint32_t guard_inputs_refused;      /**< 12: sum of guard_refused[] */
+  uint32_t guard_stale_cycles;        /**< 13: sum of guard_stale[] */
+  uint32_t telemetry_not_sent;        /**< 14: telemetry packets not emitted (no room) */
+  uint32_t calls_rejected;            /**< 15: calls refused with an error status */
+  /* details */
+  uint32_t tracker_unobserved;                       /**< particle-frames without a finite observation */
+  uint32_t tracker_empty_frames;                     /**< frames with no usable observation */
+  uint32_t estimator_empty_frames;                   /**< estimator frames with no particle to score */
+  uint32_t estimator_frames_skipped;                 /**< stepped frames never given to the estimator */
+  uint32_t frames_replaced;                          /**< pushed frames overwritten before being stepped */
+  uint32_t strain_unmeasured;                        /**< stepped frames whose strain could not be measured */
+  uint32_t guard_refused[PLIANT_GUARD_SOURCE_COUNT]; /**< per PLIANT_SOURCE_* */
+  uint32_t guard_stale[PLIANT_GUARD_SOURCE_COUNT];   /**< per PLIANT_SOURCE_* */
+  uint8_t last_rejected_status;                      /**< pliant_status_t of the last refused call */
+  uint8_t last_rejected_call;                        /**< PLIANT_CALL_* of the last refused call */
 } pliant_counters_t;
 
 /** The value of telemetry counter `id` (1..PLIANT_COUNTER_ID_COUNT) in *counters.
@@ -608,20 +591,19 @@ typedef struct pliant_counters_s
 pliant_status_t pliant_counter_by_id(const pliant_counters_t* counters, uint16_t id, uint32_t* out_value);
 
 /** What pliant_init built. */
-typedef struct pliant_info_s
-{
-    uint32_t dim;
-    uint32_t particle_count;
-    uint32_t cluster_count;
-    uint32_t drivable_count;
-    uint32_t scalar_bytes;          /**< 8: computes in double, 4: in float */
-    size_t workspace_bytes;         /**< what pliant_workspace_size asked for */
-    double spacing_m;               /**< median nearest-neighbour distance of the rest shape */
-    bool estimator_enabled;
-    bool guard_enabled;
-    double guard_extent_m;          /**< the object's extent along the squeeze axis */
-    int32_t guard_unconverged_relaxations; /**< init relaxations that hit relax_max_iterations */
-    int64_t guard_relaxation_steps; /**< MSM steps pliant_init spent on the prediction table */
+typedef struct pliant_info_s {
+  uint32_t dim;
+  uint32_t particle_count;
+  uint32_t cluster_count;
+  uint32_t drivable_count;
+  uint32_t scalar_bytes;  /**< 8: computes in double, 4: in float */
+  size_t workspace_bytes; /**< what pliant_workspace_size asked for */
+  double spacing_m;       /**< median nearest-neighbour distance of the rest shape */
+  bool estimator_enabled;
+  bool guard_enabled;
+  double guard_extent_m;                 /**< the object's extent along the squeeze axis */
+  int32_t guard_unconverged_relaxations; /**< init relaxations that hit relax_max_iterations */
+  int64_t guard_relaxation_steps;        /**< MSM steps pliant_init spent on the prediction table */
 } pliant_info_t;
 
 /* ============================================================================================
@@ -681,8 +663,7 @@ pliant_status_t pliant_push_observations(pliant_t* instance, double stamp_s, con
  *  Errors: NULL_ARGUMENT, NOT_INITIALIZED, BAD_STATE (no pending frame), INVALID_ARGUMENT
  *  (count > drivable_count, an id out of range, not drivable or repeated), NON_FINITE.
  *  Real-time safe, O(count + N). */
-pliant_status_t pliant_push_tool_contact(pliant_t* instance, const int32_t* ids, const float* targets,
-                                         uint32_t count);
+pliant_status_t pliant_push_tool_contact(pliant_t* instance, const int32_t* ids, const float* targets, uint32_t count);
 
 /** Runs the tracker on the pending frame: one MSM step of dt_s (seconds since the previous
  *  frame, normally the stamp difference; finite > 0) driven by the tool contact, robust
@@ -801,37 +782,34 @@ const char* pliant_source_name(uint8_t source);
 #ifdef __cplusplus
 #define PLIANT_U32_(value) static_cast<uint32_t>(value)
 #else
-#define PLIANT_U32_(value) ((uint32_t) (value))
+#define PLIANT_U32_(value) ((uint32_t)(value))
 #endif
 
 /** The ABI stamp of the header this translation unit was compiled with. */
-static inline pliant_abi_t pliant_abi_of_caller(void)
-{
-    pliant_abi_t abi;
-    abi.version = PLIANT_ABI_VERSION;
-    abi.config_size = PLIANT_U32_(sizeof(pliant_config_t));
-    abi.guard_input_size = PLIANT_U32_(sizeof(pliant_guard_input_t));
-    abi.verdict_size = PLIANT_U32_(sizeof(pliant_verdict_t));
-    abi.estimate_size = PLIANT_U32_(sizeof(pliant_estimate_t));
-    abi.deformation_size = PLIANT_U32_(sizeof(pliant_deformation_t));
-    abi.counters_size = PLIANT_U32_(sizeof(pliant_counters_t));
-    abi.info_size = PLIANT_U32_(sizeof(pliant_info_t));
-    return abi;
+static inline pliant_abi_t pliant_abi_of_caller(void) {
+  pliant_abi_t abi;
+  abi.version = PLIANT_ABI_VERSION;
+  abi.config_size = PLIANT_U32_(sizeof(pliant_config_t));
+  abi.guard_input_size = PLIANT_U32_(sizeof(pliant_guard_input_t));
+  abi.verdict_size = PLIANT_U32_(sizeof(pliant_verdict_t));
+  abi.estimate_size = PLIANT_U32_(sizeof(pliant_estimate_t));
+  abi.deformation_size = PLIANT_U32_(sizeof(pliant_deformation_t));
+  abi.counters_size = PLIANT_U32_(sizeof(pliant_counters_t));
+  abi.info_size = PLIANT_U32_(sizeof(pliant_info_t));
+  return abi;
 }
 
 /** Fills *config with the defaults and this header's ABI stamp. Required before setting
  *  fields: a config not made by it is refused with ABI_MISMATCH. Errors: NULL_ARGUMENT,
  *  ABI_MISMATCH (the library was built from another pliant.h). */
-static inline pliant_status_t pliant_config_init_default(pliant_config_t* config)
-{
-    const pliant_abi_t abi = pliant_abi_of_caller();
-    return pliant_config_init_default_checked(config, &abi);
+static inline pliant_status_t pliant_config_init_default(pliant_config_t* config) {
+  const pliant_abi_t abi = pliant_abi_of_caller();
+  return pliant_config_init_default_checked(config, &abi);
 }
 
 /** See pliant_guard_input_init_checked. */
-static inline pliant_status_t pliant_guard_input_init(pliant_guard_input_t* input)
-{
-    return pliant_guard_input_init_checked(input, sizeof(pliant_guard_input_t));
+static inline pliant_status_t pliant_guard_input_init(pliant_guard_input_t* input) {
+  return pliant_guard_input_init_checked(input, sizeof(pliant_guard_input_t));
 }
 
 #ifdef __cplusplus

@@ -72,8 +72,8 @@ extern "C" {
 
 /* ---- status codes (negative returns of the encoders) ------------------------------------ */
 
-#define PLIANT_TM_E_ARGUMENT (-1) /* NULL pointer, or a field out of its wire range (see each type) */
-#define PLIANT_TM_E_NO_ROOM (-2)  /* the frame does not fit in the caller's buffer; nothing usable written */
+#define PLIANT_TM_E_ARGUMENT (-1)  /* NULL pointer, or a field out of its wire range (see each type) */
+#define PLIANT_TM_E_NO_ROOM (-2)   /* the frame does not fit in the caller's buffer; nothing usable written */
 #define PLIANT_TM_E_TOO_LARGE (-3) /* the packet would exceed PLIANT_TM_MAX_PACKET */
 
 /* ---- message types ---------------------------------------------------------------------- */
@@ -104,10 +104,10 @@ typedef struct {
 
 /* 2: verdict. Codes are the core's (pliant/core/grasp_guard.hpp): GraspVerdict, GuardReason,
  * StopAction, GuardSource. Reals in SI units (m, N), strain dimensionless; NaN: not known. */
-#define PLIANT_TM_VERDICT_COUNT 3u      /* verdict < 3: 0 ok, 1 limit, 2 stop */
-#define PLIANT_TM_REASON_COUNT 19u      /* reason < 19: 0 none ... 18 estimate_uncertain */
-#define PLIANT_TM_STOP_ACTION_COUNT 2u  /* 0 freeze, 1 open */
-#define PLIANT_TM_SOURCE_COUNT 5u       /* fault_sources bits 0..4: gripper, wrench, camera, estimate, clock */
+#define PLIANT_TM_VERDICT_COUNT 3u     /* verdict < 3: 0 ok, 1 limit, 2 stop */
+#define PLIANT_TM_REASON_COUNT 19u     /* reason < 19: 0 none ... 18 estimate_uncertain */
+#define PLIANT_TM_STOP_ACTION_COUNT 2u /* 0 freeze, 1 open */
+#define PLIANT_TM_SOURCE_COUNT 5u      /* fault_sources bits 0..4: gripper, wrench, camera, estimate, clock */
 #define PLIANT_TM_VERDICT_IN_CONTACT 0x01u
 #define PLIANT_TM_VERDICT_SLIP 0x02u
 typedef struct {
@@ -136,12 +136,12 @@ typedef struct {
 
 /* One tracked frame, as the encoder reads it: every particle of the frame. */
 typedef struct {
-  uint32_t frame;          /* the tracker's frame index */
-  uint8_t dim;             /* 2 or 3 */
-  uint16_t total;          /* particles in the frame */
-  const float* positions;  /* total x dim, particle-major (x, y[, z] of particle 0, then 1...),
-                              object frame, its length unit; read only, caller-owned */
-  const uint8_t* status;   /* total entries, PLIANT_TM_OBSERVED / PREDICTED / LOST */
+  uint32_t frame;         /* the tracker's frame index */
+  uint8_t dim;            /* 2 or 3 */
+  uint16_t total;         /* particles in the frame */
+  const float* positions; /* total x dim, particle-major (x, y[, z] of particle 0, then 1...),
+                             object frame, its length unit; read only, caller-owned */
+  const uint8_t* status;  /* total entries, PLIANT_TM_OBSERVED / PREDICTED / LOST */
 } pliant_tm_particle_frame_t;
 
 /* One decoded particles chunk: particles first .. first + count - 1 of frame `frame`. The
@@ -149,10 +149,10 @@ typedef struct {
  * pliant_tm_particles_get. `items` is valid until the next call on that decoder. */
 typedef struct {
   uint32_t frame;
-  uint8_t dim;   /* 2 or 3 */
+  uint8_t dim; /* 2 or 3 */
   uint16_t total;
   uint16_t first;
-  uint16_t count; /* first + count <= total */
+  uint16_t count;       /* first + count <= total */
   const uint8_t* items; /* count x PLIANT_TM_PARTICLE_SIZE(dim) wire bytes */
 } pliant_tm_particles_t;
 
@@ -228,20 +228,20 @@ void pliant_tm_encoder_init(pliant_tm_encoder_t* encoder, uint16_t first_seq);
  * PLIANT_TM_MAX_FRAME bytes always suffices. O(frame length); no other memory touched. */
 
 /* 1: estimate, 29-byte payload: frame of 45 bytes. */
-int32_t pliant_tm_encode_estimate(pliant_tm_encoder_t* encoder, uint64_t stamp_us,
-                                  const pliant_tm_estimate_t* estimate, uint8_t* out, size_t capacity);
+int32_t pliant_tm_encode_estimate(pliant_tm_encoder_t* encoder, uint64_t stamp_us, const pliant_tm_estimate_t* estimate,
+                                  uint8_t* out, size_t capacity);
 
 /* 2: verdict, 52-byte payload: frame of 68 bytes. PLIANT_TM_E_ARGUMENT when verdict, reason,
  * stop_action, fault_sources or reasons is out of its range above. */
-int32_t pliant_tm_encode_verdict(pliant_tm_encoder_t* encoder, uint64_t stamp_us,
-                                 const pliant_tm_verdict_t* verdict, uint8_t* out, size_t capacity);
+int32_t pliant_tm_encode_verdict(pliant_tm_encoder_t* encoder, uint64_t stamp_us, const pliant_tm_verdict_t* verdict,
+                                 uint8_t* out, size_t capacity);
 
 /* 3: particles first .. first + count - 1 of `frame` as one chunk. PLIANT_TM_E_ARGUMENT when dim
  * is not 2 or 3, first + count > total, a status is above PLIANT_TM_LOST, or a pointer is NULL
  * while total > 0; PLIANT_TM_E_TOO_LARGE when count > PLIANT_TM_MAX_CHUNK_PARTICLES(dim). */
 int32_t pliant_tm_encode_particles(pliant_tm_encoder_t* encoder, uint64_t stamp_us,
-                                   const pliant_tm_particle_frame_t* frame, uint16_t first,
-                                   uint16_t count, uint8_t* out, size_t capacity);
+                                   const pliant_tm_particle_frame_t* frame, uint16_t first, uint16_t count,
+                                   uint8_t* out, size_t capacity);
 
 /* Splitting a frame into chunks: the most particles of dimension dim (2 or 3) whose particles
  * frame fits in frame_capacity bytes and in one packet (0 when not even one fits, or dim is
@@ -267,16 +267,14 @@ int32_t pliant_tm_encode_particles_next(pliant_tm_encoder_t* encoder, uint64_t s
 /* 4: counters, count entries (count <= PLIANT_TM_MAX_COUNTERS, else PLIANT_TM_E_TOO_LARGE).
  * PLIANT_TM_E_ARGUMENT when counters is NULL with count > 0, or two entries share an id.
  * O(count^2) for the duplicate check (count <= 168). */
-int32_t pliant_tm_encode_counters(pliant_tm_encoder_t* encoder, uint64_t stamp_us,
-                                  const pliant_tm_counter_t* counters, uint16_t count, uint8_t* out,
-                                  size_t capacity);
+int32_t pliant_tm_encode_counters(pliant_tm_encoder_t* encoder, uint64_t stamp_us, const pliant_tm_counter_t* counters,
+                                  uint16_t count, uint8_t* out, size_t capacity);
 
 /* ---- decoded payload access ------------------------------------------------------------- */
 
 /* Particle i (< particles->count) of a decoded chunk: its id is particles->first + i; writes dim
  * coordinates to position (the third is set to 0 in 2D) and its status. O(1). */
-void pliant_tm_particles_get(const pliant_tm_particles_t* particles, uint16_t i, float position[3],
-                             uint8_t* status);
+void pliant_tm_particles_get(const pliant_tm_particles_t* particles, uint16_t i, float position[3], uint8_t* status);
 
 /* Entry i (< counters->count) of a decoded counters message. O(1). */
 pliant_tm_counter_t pliant_tm_counters_get(const pliant_tm_counters_t* counters, uint16_t i);
@@ -330,8 +328,8 @@ void pliant_tm_decoder_init(pliant_tm_decoder_t* decoder);
  * or init on this decoder. Empty frames (0x00 0x00) are ignored: emitters may send a lone 0x00 to
  * mark a frame start. Returns 0 with *consumed = 0 when decoder, consumed or out is NULL, or data
  * is NULL with size > 0. O(size + PLIANT_TM_MAX_FRAME) per call. */
-int pliant_tm_decoder_push(pliant_tm_decoder_t* decoder, const uint8_t* data, size_t size,
-                           size_t* consumed, pliant_tm_message_t* out);
+int pliant_tm_decoder_push(pliant_tm_decoder_t* decoder, const uint8_t* data, size_t size, size_t* consumed,
+                           pliant_tm_message_t* out);
 
 /* End of stream: a frame still being received is dropped and counted as truncated; the decoder
  * is ready for a new stream (sequence tracking restarts, counters are kept). O(1). */

@@ -38,10 +38,10 @@ struct FrameBuffers {
   Vec* contact_targets = nullptr;   ///< [drivable_count]
   int* last_contact_ids = nullptr;  ///< [drivable_count] the last stepped frame's contact
   Vec* last_contact_targets = nullptr;
-  Vec* strain_positions = nullptr;    ///< [N] last tracked frame, lost particles NaN (guard on)
-  Vec* estimate_positions = nullptr;  ///< [N] last tracked frame, observed particles only (estimator on)
-  std::uint8_t* contact_mark = nullptr;  ///< [N] all 0 between calls: repeated-id check scratch
-  float* telemetry_positions = nullptr;  ///< [N * Dim] the tracked frame as the codec reads it
+  Vec* strain_positions = nullptr;           ///< [N] last tracked frame, lost particles NaN (guard on)
+  Vec* estimate_positions = nullptr;         ///< [N] last tracked frame, observed particles only (estimator on)
+  std::uint8_t* contact_mark = nullptr;      ///< [N] all 0 between calls: repeated-id check scratch
+  float* telemetry_positions = nullptr;      ///< [N * Dim] the tracked frame as the codec reads it
   std::uint8_t* telemetry_status = nullptr;  ///< [N]
 };
 
@@ -75,21 +75,21 @@ struct Common {
 
   // The last stepped frame.
   bool has_frame = false;
-  double last_stamp_s = -kInf;      ///< stamp order reference (kept across reset_grasp)
-  double frame_stamp_s = kNaN;      ///< stamp of the last frame stepped since init / reset
+  double last_stamp_s = -kInf;  ///< stamp order reference (kept across reset_grasp)
+  double frame_stamp_s = kNaN;  ///< stamp of the last frame stepped since init / reset
   double frame_dt_s = 0;
   int last_contact_count = 0;
-  bool estimate_due = false;        ///< the last stepped frame has not been given to the estimator
-  double skipped_dt_s = 0;          ///< time of stepped frames the estimator missed
+  bool estimate_due = false;  ///< the last stepped frame has not been given to the estimator
+  double skipped_dt_s = 0;    ///< time of stepped frames the estimator missed
 
   // Published samples.
   pliant_deformation_t deformation{};
-  double estimate_stamp_s = kNaN;   ///< frame of the last estimator update; NaN before any
+  double estimate_stamp_s = kNaN;        ///< frame of the last estimator update; NaN before any
   OnlineDeformabilityEstimate estimate;  ///< cached after each estimator update
   bool estimate_fed_back = false;
   pliant_verdict_t last_verdict{};  ///< the last guard cycle's verdict (telemetry)
   bool has_verdict = false;
-  pliant_tm_encoder_t telemetry{};   ///< sequence numbers of emitted packets
+  pliant_tm_encoder_t telemetry{};  ///< sequence numbers of emitted packets
 
   // The bridge's own counters.
   std::uint32_t estimator_frames = 0;  ///< the core's count restarts at reset; this one does not
@@ -172,7 +172,8 @@ MsmParams<Dim, Scalar> to_core_params(const pliant_msm_config_t& msm) noexcept {
 }
 
 template <int Dim>
-GraspObject<Dim, Scalar> to_core_object(const pliant_guard_config_t& guard, const int* jaw_a, const int* jaw_b) noexcept {
+GraspObject<Dim, Scalar> to_core_object(const pliant_guard_config_t& guard, const int* jaw_a,
+                                        const int* jaw_b) noexcept {
   GraspObject<Dim, Scalar> object;
   for (int d = 0; d < Dim; ++d) object.squeeze_axis(d) = static_cast<Scalar>(guard.squeeze_axis[d]);
   object.jaw_a_ids = jaw_a;

@@ -111,23 +111,21 @@ bool ids_valid(const int32_t* ids, std::uint32_t count, std::uint32_t n) noexcep
 
 pliant_status_t validate_clusters(const pliant_cluster_config_t& c, std::uint32_t dim) noexcept {
   switch (c.layout) {
-    case PLIANT_CLUSTERS_RADIUS:
-      return positive_finite(c.radius_factor) ? PLIANT_OK : PLIANT_ERROR_INVALID_ARGUMENT;
-    case PLIANT_CLUSTERS_K_NEAREST:
-      return c.k >= 1 && c.k <= 64 ? PLIANT_OK : PLIANT_ERROR_INVALID_ARGUMENT;
+    case PLIANT_CLUSTERS_RADIUS: return positive_finite(c.radius_factor) ? PLIANT_OK : PLIANT_ERROR_INVALID_ARGUMENT;
+    case PLIANT_CLUSTERS_K_NEAREST: return c.k >= 1 && c.k <= 64 ? PLIANT_OK : PLIANT_ERROR_INVALID_ARGUMENT;
     case PLIANT_CLUSTERS_GRID_BLOCKS: {
       const bool sizes = c.grid_cols > 0 && c.grid_rows > 0 && c.grid_layers > 0 && c.block_cols > 0 &&
                          c.block_rows > 0 && c.block_layers > 0 && c.block_cols <= c.grid_cols &&
                          c.block_rows <= c.grid_rows && c.block_layers <= c.grid_layers;
       return sizes && (dim == 3 || c.grid_layers == 1) ? PLIANT_OK : PLIANT_ERROR_INVALID_ARGUMENT;
     }
-    default:
-      return PLIANT_ERROR_INVALID_ARGUMENT;
+    default: return PLIANT_ERROR_INVALID_ARGUMENT;
   }
 }
 
 pliant_status_t validate_msm(const pliant_msm_config_t& m) noexcept {
-  if (!is_finite(m.msm_alpha) || !is_finite(m.msm_beta) || !is_finite(m.velocity_damping) || !is_finite(m.driven_mass_factor)) {
+  if (!is_finite(m.msm_alpha) || !is_finite(m.msm_beta) || !is_finite(m.velocity_damping) ||
+      !is_finite(m.driven_mass_factor)) {
     return PLIANT_ERROR_NON_FINITE;
   }
   for (double g : m.gravity) {
@@ -141,8 +139,8 @@ pliant_status_t validate_msm(const pliant_msm_config_t& m) noexcept {
 
 pliant_status_t validate_tracker(const pliant_tracker_config_t& t) noexcept {
   const bool ok = positive_finite(t.tukey_c) && non_negative_finite(t.min_residual_scale) &&
-                  positive_finite(t.observation_gain) && t.observation_gain <= 1 && t.projection_iterations >= 0 && t.projection_iterations <= 64 &&
-                  t.max_unobserved_frames >= 1;
+                  positive_finite(t.observation_gain) && t.observation_gain <= 1 && t.projection_iterations >= 0 &&
+                  t.projection_iterations <= 64 && t.max_unobserved_frames >= 1;
   return ok ? PLIANT_OK : PLIANT_ERROR_INVALID_ARGUMENT;
 }
 

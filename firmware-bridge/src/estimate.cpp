@@ -21,9 +21,8 @@ pliant_status_t pliant_update_estimate(pliant_t* instance) {
     driven.ids = engine.last_contact_ids;
     driven.positions = engine.last_contact_targets;
     driven.count = c.last_contact_count;
-    const pliant::Status updated = pliant::online_deformability_update(engine.model, engine.estimator,
-                                                                       static_cast<Scalar>(dt), driven,
-                                                                       engine.estimate_positions);
+    const pliant::Status updated = pliant::online_deformability_update(
+        engine.model, engine.estimator, static_cast<Scalar>(dt), driven, engine.estimate_positions);
     if (updated == pliant::Status::ok || updated == pliant::Status::no_observations) {
       c.estimate = pliant::online_deformability_estimate(engine.estimator);
       const double sd = c.estimate.msm_beta_std;
@@ -56,7 +55,8 @@ pliant_status_t pliant_get_estimate(pliant_t* instance, pliant_estimate_t* out) 
   e.unique_minimum = c.estimate.unique_minimum;
   e.valid = c.estimate.frames > 0 && is_finite(c.estimate.msm_beta_std);
   e.fed_back = c.estimate_fed_back;
-  e.tracker_msm_beta = dispatch(instance, [](auto& engine) { return static_cast<double>(engine.tracker.params.msm_beta); });
+  e.tracker_msm_beta =
+      dispatch(instance, [](auto& engine) { return static_cast<double>(engine.tracker.params.msm_beta); });
   *out = e;
   return PLIANT_OK;
 }

@@ -15,7 +15,8 @@ void publish_frame(Common& c, Engine<Dim>& engine) noexcept {
   const pliant::Tracker<Dim, Scalar>& tracker = engine.tracker;
   if (engine.strain_positions != nullptr) {
     for (int i = 0; i < n; ++i) {
-      engine.strain_positions[i] = tracker.status[i] == pliant::TrackStatus::lost ? unobserved : tracker.state.position[i];
+      engine.strain_positions[i] =
+          tracker.status[i] == pliant::TrackStatus::lost ? unobserved : tracker.state.position[i];
     }
   }
   if (engine.estimate_positions != nullptr) {
@@ -92,7 +93,8 @@ pliant_status_t pliant_push_tool_contact(pliant_t* instance, const int32_t* ids,
       }
       engine.contact_mark[id] = 1;
       for (int d = 0; d < kDim; ++d) {
-        if (!std::isfinite(targets[std::size_t{marked} * kDim + static_cast<std::size_t>(d)])) verdict = PLIANT_ERROR_NON_FINITE;
+        if (!std::isfinite(targets[std::size_t{marked} * kDim + static_cast<std::size_t>(d)]))
+          verdict = PLIANT_ERROR_NON_FINITE;
       }
       if (verdict != PLIANT_OK) {
         ++marked;
@@ -103,7 +105,9 @@ pliant_status_t pliant_push_tool_contact(pliant_t* instance, const int32_t* ids,
     if (verdict != PLIANT_OK) return verdict;
     for (std::uint32_t k = 0; k < count; ++k) {
       engine.contact_ids[k] = ids[k];
-      for (int d = 0; d < kDim; ++d) engine.contact_targets[k](d) = static_cast<Scalar>(targets[std::size_t{k} * kDim + static_cast<std::size_t>(d)]);
+      for (int d = 0; d < kDim; ++d)
+        engine.contact_targets[k](d) =
+            static_cast<Scalar>(targets[std::size_t{k} * kDim + static_cast<std::size_t>(d)]);
     }
     return PLIANT_OK;
   });
@@ -118,7 +122,8 @@ pliant_status_t pliant_step_tracker(pliant_t* instance, double dt_s) {
   Common& c = instance->common;
   constexpr std::uint8_t kCall = PLIANT_CALL_STEP_TRACKER;
   if (!is_finite(dt_s)) return reject(instance, kCall, PLIANT_ERROR_NON_FINITE);
-  if (!(dt_s > 0) || !(static_cast<Scalar>(dt_s) > Scalar(0))) return reject(instance, kCall, PLIANT_ERROR_INVALID_ARGUMENT);
+  if (!(dt_s > 0) || !(static_cast<Scalar>(dt_s) > Scalar(0)))
+    return reject(instance, kCall, PLIANT_ERROR_INVALID_ARGUMENT);
   if (!c.pending) return reject(instance, kCall, PLIANT_ERROR_BAD_STATE);
   c.pending = false;
   const pliant::Status stepped = dispatch(instance, [&](auto& engine) {

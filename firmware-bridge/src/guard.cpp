@@ -110,8 +110,8 @@ pliant_status_t pliant_guard_update(pliant_t* instance, const pliant_guard_input
   }
   const pliant::GraspGuardInput core_input = to_core(*input, c);
   pliant::GraspGuardOutput core_output;
-  const pliant::Status status =
-      dispatch(instance, [&](auto& engine) { return pliant::grasp_guard_update(engine.guard, core_input, core_output); });
+  const pliant::Status status = dispatch(
+      instance, [&](auto& engine) { return pliant::grasp_guard_update(engine.guard, core_input, core_output); });
   if (status != pliant::Status::ok) return reject(instance, kCall, to_status(status));
   to_abi(core_output, *out);
   instance->common.last_verdict = *out;

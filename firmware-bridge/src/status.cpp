@@ -6,7 +6,8 @@
 
 // The header's version must be the project's (CMake passes project(VERSION) in).
 #if defined(PLIANT_PROJECT_VERSION_MAJOR)
-static_assert(PLIANT_VERSION_MAJOR == PLIANT_PROJECT_VERSION_MAJOR && PLIANT_VERSION_MINOR == PLIANT_PROJECT_VERSION_MINOR &&
+static_assert(PLIANT_VERSION_MAJOR == PLIANT_PROJECT_VERSION_MAJOR &&
+                  PLIANT_VERSION_MINOR == PLIANT_PROJECT_VERSION_MINOR &&
                   PLIANT_VERSION_PATCH == PLIANT_PROJECT_VERSION_PATCH,
               "pliant.h PLIANT_VERSION_* differs from the CMake project version");
 #endif

@@ -58,8 +58,8 @@ static int take_frame(pliant_tm_decoder_t* d, size_t length, pliant_tm_message_t
   return 1;
 }
 
-int pliant_tm_decoder_push(pliant_tm_decoder_t* decoder, const uint8_t* data, size_t size,
-                           size_t* consumed, pliant_tm_message_t* out) {
+int pliant_tm_decoder_push(pliant_tm_decoder_t* decoder, const uint8_t* data, size_t size, size_t* consumed,
+                           pliant_tm_message_t* out) {
   if (consumed != NULL) *consumed = 0u;
   if (decoder == NULL || consumed == NULL || out == NULL || (data == NULL && size > 0u)) return 0;
   for (size_t i = 0; i < size; ++i) {

@@ -7,7 +7,8 @@ using namespace pliant::bridge;
 static_assert(PLIANT_TRACK_OBSERVED == PLIANT_TM_OBSERVED && PLIANT_TRACK_PREDICTED == PLIANT_TM_PREDICTED &&
               PLIANT_TRACK_LOST == PLIANT_TM_LOST);
 static_assert(PLIANT_REASON_COUNT == PLIANT_TM_REASON_COUNT && PLIANT_GUARD_SOURCE_COUNT == PLIANT_TM_SOURCE_COUNT &&
-              PLIANT_VERDICT_STOP + 1 == PLIANT_TM_VERDICT_COUNT && PLIANT_STOP_OPEN + 1 == PLIANT_TM_STOP_ACTION_COUNT);
+              PLIANT_VERDICT_STOP + 1 == PLIANT_TM_VERDICT_COUNT &&
+              PLIANT_STOP_OPEN + 1 == PLIANT_TM_STOP_ACTION_COUNT);
 static_assert(PLIANT_COUNTER_TRACKER_FRAMES == PLIANT_TM_COUNTER_TRACKER_FRAMES &&
               PLIANT_COUNTER_TRACKER_FRAMES_REJECTED == PLIANT_TM_COUNTER_TRACKER_FRAMES_REJECTED &&
               PLIANT_COUNTER_OBSERVATIONS_USED == PLIANT_TM_COUNTER_OBSERVATIONS_USED &&
@@ -124,10 +125,9 @@ pliant_status_t pliant_emit_telemetry(pliant_t* instance, uint32_t message_mask,
     e.msm_beta_std = c.estimate.msm_beta_std;
     e.rms = c.estimate.rms;
     e.frames = c.estimate.frames;
-    e.flags = static_cast<std::uint8_t>((c.estimate.unique_minimum ? PLIANT_TM_ESTIMATE_UNIQUE_MINIMUM : 0u) |
-                                        (c.estimate.frames > 0 && is_finite(c.estimate.msm_beta_std)
-                                             ? PLIANT_TM_ESTIMATE_VALID
-                                             : 0u));
+    e.flags = static_cast<std::uint8_t>(
+        (c.estimate.unique_minimum ? PLIANT_TM_ESTIMATE_UNIQUE_MINIMUM : 0u) |
+        (c.estimate.frames > 0 && is_finite(c.estimate.msm_beta_std) ? PLIANT_TM_ESTIMATE_VALID : 0u));
     ok = ok && append(pliant_tm_encode_estimate(&encoder, stamp_us, &e, buffer + used, capacity - used), used);
   }
 
@@ -188,9 +188,9 @@ pliant_status_t pliant_emit_telemetry(pliant_t* instance, uint32_t message_mask,
       entries[id - 1].id = id;
       (void)pliant_counter_by_id(&counters, id, &entries[id - 1].value);
     }
-    ok = append(pliant_tm_encode_counters(&encoder, stamp_us, entries, PLIANT_COUNTER_ID_COUNT, buffer + used,
-                                          capacity - used),
-                used);
+    ok = append(
+        pliant_tm_encode_counters(&encoder, stamp_us, entries, PLIANT_COUNTER_ID_COUNT, buffer + used, capacity - used),
+        used);
   }
 
   if (!ok) {

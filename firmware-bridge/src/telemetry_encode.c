@@ -48,8 +48,8 @@ static int32_t finish(pliant_tm_encoder_t* encoder, pliant_tm_cobs_writer_t* w) 
   return length;
 }
 
-int32_t pliant_tm_encode_estimate(pliant_tm_encoder_t* encoder, uint64_t stamp_us,
-                                  const pliant_tm_estimate_t* estimate, uint8_t* out, size_t capacity) {
+int32_t pliant_tm_encode_estimate(pliant_tm_encoder_t* encoder, uint64_t stamp_us, const pliant_tm_estimate_t* estimate,
+                                  uint8_t* out, size_t capacity) {
   if (encoder == NULL || estimate == NULL || out == NULL) return PLIANT_TM_E_ARGUMENT;
   pliant_tm_cobs_writer_t w;
   pliant_tm_writer_begin(&w, out, capacity);
@@ -62,8 +62,8 @@ int32_t pliant_tm_encode_estimate(pliant_tm_encoder_t* encoder, uint64_t stamp_u
   return finish(encoder, &w);
 }
 
-int32_t pliant_tm_encode_verdict(pliant_tm_encoder_t* encoder, uint64_t stamp_us,
-                                 const pliant_tm_verdict_t* v, uint8_t* out, size_t capacity) {
+int32_t pliant_tm_encode_verdict(pliant_tm_encoder_t* encoder, uint64_t stamp_us, const pliant_tm_verdict_t* v,
+                                 uint8_t* out, size_t capacity) {
   if (encoder == NULL || v == NULL || out == NULL) return PLIANT_TM_E_ARGUMENT;
   if (v->verdict >= PLIANT_TM_VERDICT_COUNT || v->reason >= PLIANT_TM_REASON_COUNT ||
       v->stop_action >= PLIANT_TM_STOP_ACTION_COUNT || (v->fault_sources >> PLIANT_TM_SOURCE_COUNT) != 0u ||
@@ -80,16 +80,16 @@ int32_t pliant_tm_encode_verdict(pliant_tm_encoder_t* encoder, uint64_t stamp_us
   pliant_tm_writer_u32(&w, v->reasons);
   pliant_tm_writer_byte(&w, v->flags, 1);
   for (int i = 0; i < 3; ++i) pliant_tm_writer_byte(&w, 0u, 1); /* reserved */
-  const float reals[10] = {v->closure_m,      v->force_n,        v->strain,       v->allowed_force_n,
+  const float reals[10] = {v->closure_m,        v->force_n,        v->strain,       v->allowed_force_n,
                            v->predicted_strain, v->safe_closure_m, v->safe_width_m, v->predicted_force_n,
-                           v->beta_low,       v->beta_high};
+                           v->beta_low,         v->beta_high};
   for (int i = 0; i < 10; ++i) pliant_tm_writer_f32(&w, reals[i]);
   return finish(encoder, &w);
 }
 
 int32_t pliant_tm_encode_particles(pliant_tm_encoder_t* encoder, uint64_t stamp_us,
-                                   const pliant_tm_particle_frame_t* frame, uint16_t first,
-                                   uint16_t count, uint8_t* out, size_t capacity) {
+                                   const pliant_tm_particle_frame_t* frame, uint16_t first, uint16_t count,
+                                   uint8_t* out, size_t capacity) {
   if (encoder == NULL || frame == NULL || out == NULL) return PLIANT_TM_E_ARGUMENT;
   if (frame->dim != 2u && frame->dim != 3u) return PLIANT_TM_E_ARGUMENT;
   if ((uint32_t)first + count > frame->total) return PLIANT_TM_E_ARGUMENT;
@@ -142,9 +142,8 @@ int32_t pliant_tm_encode_particles_next(pliant_tm_encoder_t* encoder, uint64_t s
   return length;
 }
 
-int32_t pliant_tm_encode_counters(pliant_tm_encoder_t* encoder, uint64_t stamp_us,
-                                  const pliant_tm_counter_t* counters, uint16_t count, uint8_t* out,
-                                  size_t capacity) {
+int32_t pliant_tm_encode_counters(pliant_tm_encoder_t* encoder, uint64_t stamp_us, const pliant_tm_counter_t* counters,
+                                  uint16_t count, uint8_t* out, size_t capacity) {
   if (encoder == NULL || out == NULL || (counters == NULL && count > 0u)) return PLIANT_TM_E_ARGUMENT;
   if (count > PLIANT_TM_MAX_COUNTERS) return PLIANT_TM_E_TOO_LARGE;
   for (uint16_t i = 0; i < count; ++i) {

@@ -2,8 +2,7 @@
 #include "pliant_telemetry.h"
 #include "telemetry_wire.h"
 
-void pliant_tm_particles_get(const pliant_tm_particles_t* particles, uint16_t i, float position[3],
-                             uint8_t* status) {
+void pliant_tm_particles_get(const pliant_tm_particles_t* particles, uint16_t i, float position[3], uint8_t* status) {
   const uint8_t* item = particles->items + (size_t)i * PLIANT_TM_PARTICLE_SIZE((size_t)particles->dim);
   position[2] = 0.0f;
   for (unsigned axis = 0; axis < particles->dim; ++axis) position[axis] = pliant_tm_get_f32(item + 4u * axis);

@@ -47,7 +47,7 @@ typedef struct {
   size_t code_at; /* position of the current block's code byte */
   uint8_t code;   /* 1 + data bytes in the current block */
   uint8_t overflow;
-  uint16_t crc;   /* CRC-16/CCITT-FALSE of the packet bytes so far */
+  uint16_t crc; /* CRC-16/CCITT-FALSE of the packet bytes so far */
 } pliant_tm_cobs_writer_t;
 
 void pliant_tm_writer_begin(pliant_tm_cobs_writer_t* w, uint8_t* out, size_t capacity);

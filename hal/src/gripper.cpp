@@ -36,11 +36,8 @@ HalStatus Gripper::write(const GripperCommand& command) noexcept {
         clamped.speed_m_per_s = std::min(command.speed_m_per_s, l.max_speed_m_per_s);
       }
       break;
-    case GripperCommandKind::stop:
-      break;
-    default:
-      valid = false;
-      break;
+    case GripperCommandKind::stop: break;
+    default: valid = false; break;
   }
   const HalStatus status = valid ? on_write(clamped) : HalStatus::invalid_argument;
   account_write(status);

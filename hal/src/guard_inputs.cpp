@@ -16,15 +16,9 @@ bool apply_status(HalStatus status, Sample& sample) noexcept {
       sample.timeout = false;
       sample.bus_off = false;
       return false;
-    case HalStatus::timeout:
-      sample.timeout = true;
-      return false;
-    case HalStatus::bus_off:
-      sample.bus_off = true;
-      return false;
-    default:
-      sample.valid = false;
-      return false;
+    case HalStatus::timeout: sample.timeout = true; return false;
+    case HalStatus::bus_off: sample.bus_off = true; return false;
+    default: sample.valid = false; return false;
   }
 }
 

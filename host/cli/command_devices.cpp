@@ -10,10 +10,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli_registry.hpp"
 #include "exit_status.hpp"
-#if PLIANT_HAVE_DRIVER_USB
-#include "pliant/drivers/usb/usb_devices.hpp"
-#endif
 
 namespace pliant::cli {
 namespace {
@@ -51,6 +49,15 @@ std::vector<std::string> can_interfaces() {
   return out;
 }
 
+// The registered schemes of one category, "v4l2 (opencv), video (opencv)"; "none" without any.
+std::string scheme_list(const hal::DeviceRegistry& registry, hal::DeviceCategory category) {
+  std::string out;
+  for (const hal::SchemeInfo& s : registry.schemes(category)) {
+    out += (out.empty() ? "" : ", ") + s.scheme + " (" + s.driver + ")";
+  }
+  return out.empty() ? "none" : out;
+}
+
 }  // namespace
 
 DevicesCommand::DevicesCommand(CLI::App& parent) {
@@ -58,36 +65,56 @@ DevicesCommand::DevicesCommand(CLI::App& parent) {
   app_->footer(
       "USB depth cameras and USB-CAN adapters known to pliant (VID:PID table, docs/drivers/usb.md), CAN network "
       "interfaces (for --ft ati-can:IFACE@..., robotous-can:...), video devices (v4l2:...) and serial ports "
-      "(robotiq-rtu:..., ft300-rtu:...). An empty list is not an error.");
+      "(robotiq-rtu:..., ft300-rtu:...), then the device schemes this build's drivers open (pliant record). An empty "
+      "list is not an error.");
   app_->add_flag("--all", all_, "also list USB devices pliant does not know");
   app_->add_flag("--json", json_, "one JSON object instead of text");
 }
 
 int DevicesCommand::run() const {
+  const hal::DeviceRegistry& registry = cli_registry().devices;
   std::vector<std::string> notes;
   nlohmann::json usb = nlohmann::json::array();
   std::string usb_text;
-#if PLIANT_HAVE_DRIVER_USB
-  drivers::usb::UsbRowOptions options;
-  options.include_unknown = all_;
-  const auto rows = drivers::usb::list_usb_devices(options, notes);
-  for (const auto& r : rows) {
-    usb.push_back({{"name", r.name}, {"kind", r.kind}, {"id", r.id}, {"location", r.location},
-                   {"handled_by", r.handled_by}, {"detail", r.detail}});
+  if (registry.find_discovery("usb") != nullptr) {  // drivers/usb
+    hal::DiscoveryOptions options;
+    options.include_unknown = all_;
+    hal::Discovery found = registry.discover("usb", options);
+    for (const hal::DiscoveredDevice& r : found.devices) {
+      usb.push_back({{"name", r.name},
+                     {"kind", r.kind},
+                     {"id", r.id},
+                     {"location", r.location},
+                     {"handled_by", r.handled_by},
+                     {"detail", r.detail}});
+    }
+    notes = std::move(found.notes);
+    usb_text = std::move(found.text);
+  } else {
+    notes.push_back("USB discovery is not in this build (Debian package libusb-1.0-0-dev)");
+    usb_text = "USB: not in this build (Debian package libusb-1.0-0-dev)\n";
   }
-  usb_text = drivers::usb::format_usb_device_table(rows, notes);
-#else
-  notes.push_back("USB discovery is not in this build (Debian package libusb-1.0-0-dev)");
-  usb_text = "USB: not in this build (Debian package libusb-1.0-0-dev)\n";
-#endif
   const std::vector<std::string> can = can_interfaces();
   const std::vector<std::string> video = entries_with_prefix("/dev", {"video"});
   const std::vector<std::string> serial = entries_with_prefix("/dev", {"ttyUSB", "ttyACM"});
   if (json_) {
-    nlohmann::json j = {{"usb", usb}, {"notes", notes}, {"can", can}, {"video", nlohmann::json::array()},
-                        {"serial", nlohmann::json::array()}};
+    nlohmann::json j = {{"usb", usb},
+                        {"notes", notes},
+                        {"can", can},
+                        {"video", nlohmann::json::array()},
+                        {"serial", nlohmann::json::array()},
+                        {"drivers", registry.drivers()},
+                        {"schemes", nlohmann::json::array()}};
     for (const std::string& v : video) j["video"].push_back("/dev/" + v);
     for (const std::string& s : serial) j["serial"].push_back("/dev/" + s);
+    for (const hal::SchemeInfo& s : registry.schemes()) {
+      j["schemes"].push_back({{"scheme", s.scheme},
+                              {"category", hal::device_category_name(s.category)},
+                              {"driver", s.driver},
+                              {"location", s.location},
+                              {"description", s.description},
+                              {"parameters", s.parameters}});
+    }
     std::cout << j.dump(2) << '\n';
     return exit_ok;
   }
@@ -102,6 +129,11 @@ int DevicesCommand::run() const {
   list("CAN interfaces", can, "");
   list("video devices", video, "/dev/");
   list("serial ports", serial, "/dev/");
+  std::cout << "device schemes in this build (pliant record --color, --depth, --ft, --gripper):\n";
+  for (const hal::DeviceCategory category : {hal::DeviceCategory::color_camera, hal::DeviceCategory::depth_camera,
+                                             hal::DeviceCategory::force_torque, hal::DeviceCategory::gripper}) {
+    std::cout << "  " << hal::device_category_name(category) << ": " << scheme_list(registry, category) << '\n';
+  }
   return exit_ok;
 }
 

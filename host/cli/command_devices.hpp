@@ -1,7 +1,8 @@
 // `pliant devices [--all] [--json]`: what is connected that pliant can use: USB depth cameras and
-// USB-CAN adapters (drivers/usb: VID:PID table, sysfs strings, the adapter's canN interface),
-// CAN network interfaces, video devices and serial ports. Works with nothing connected (and
-// without the usb driver in the build: the USB part then says so).
+// USB-CAN adapters (the discovery "usb" that drivers/usb registers: VID:PID table, sysfs strings,
+// the adapter's canN interface), CAN network interfaces, video devices and serial ports; then the
+// device schemes the drivers of this build registered (cli_registry.hpp). Works with nothing
+// connected (and without the usb driver in the build: the USB part then says so).
 #pragma once
 
 #include <CLI/CLI.hpp>

@@ -28,8 +28,7 @@ EstimateCommand::EstimateCommand(CLI::App& parent) {
                    "Also write the pliant-estimate v1 JSON to OUT (atomically); '-' prints it to stdout "
                    "instead of the summary")
       ->type_name("OUT");
-  app_->add_option("--mode", mode_,
-                   "'trajectory': simulate every frame; 'final': match the final equilibrium only")
+  app_->add_option("--mode", mode_, "'trajectory': simulate every frame; 'final': match the final equilibrium only")
       ->type_name("final|trajectory")
       ->capture_default_str();
   auto* alpha_flag = app_->add_flag("--alpha", estimate_alpha_, "Also estimate msm_alpha (trajectory mode only)");

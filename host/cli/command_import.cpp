@@ -89,24 +89,27 @@ ImportCommand::ImportCommand(CLI::App& parent) {
   compression_->add_option("-o,--output", output_, "Recording directory (one CSV) or parent directory (several)")
       ->type_name("DIR")
       ->required();
-  compression_->add_option("--max-strain", max_strain_,
-                           "Stop at the first frame whose strain compression/height exceeds E, in (0, 1) "
-                           "(default: the whole test)")
+  compression_
+      ->add_option("--max-strain", max_strain_,
+                   "Stop at the first frame whose strain compression/height exceeds E, in (0, 1) "
+                   "(default: the whole test)")
       ->type_name("E");
-  auto* frames = compression_->add_option("--frames", frames_, "Frames evenly spaced over the test (>= 2)")
-                     ->type_name("N");
+  auto* frames =
+      compression_->add_option("--frames", frames_, "Frames evenly spaced over the test (>= 2)")->type_name("N");
   compression_->add_option("--frame-interval", frame_interval_s_, "Seconds between frames (> 0)")
       ->type_name("S")
       ->capture_default_str()
       ->excludes(frames);
-  compression_->add_option("--contact", contact_,
-                           "Platens: frictionless (faces slide: lateral expansion of uniaxial stress, as the "
-                           "lab's reference moduli assume) or bonded (faces stick)")
+  compression_
+      ->add_option("--contact", contact_,
+                   "Platens: frictionless (faces slide: lateral expansion of uniaxial stress, as the "
+                   "lab's reference moduli assume) or bonded (faces stick)")
       ->type_name("frictionless|bonded")
       ->capture_default_str();
-  compression_->add_option("--expansion", expansion_,
-                           "Frictionless lateral stretch: small-strain 1 + nu e (stress-free for a corotational "
-                           "linear model) or finite-strain (1 - e)^-nu (volume-keeping at nu = 0.5)")
+  compression_
+      ->add_option("--expansion", expansion_,
+                   "Frictionless lateral stretch: small-strain 1 + nu e (stress-free for a corotational "
+                   "linear model) or finite-strain (1 - e)^-nu (volume-keeping at nu = 0.5)")
       ->type_name("small-strain|finite-strain")
       ->capture_default_str();
   compression_->add_option("--poisson-ratio", poisson_ratio_, "material.poisson_ratio, in [0, 0.5)")
@@ -115,8 +118,9 @@ ImportCommand::ImportCommand(CLI::App& parent) {
   compression_->add_option("--density", density_kg_m3_, "material.density in kg/m^3, in (0, 1e5]")
       ->type_name("RHO")
       ->capture_default_str();
-  compression_->add_option("--mesh-divisions", mesh_divisions_,
-                           "Cylinder mesh: r rings outside the core, c nodes around (multiple of 8), z layers")
+  compression_
+      ->add_option("--mesh-divisions", mesh_divisions_,
+                   "Cylinder mesh: r rings outside the core, c nodes around (multiple of 8), z layers")
       ->type_name("r,c,z")
       ->capture_default_str();
   compression_->add_option("--source", source_, "meta.source: where the data comes from")->type_name("TEXT");
@@ -196,8 +200,7 @@ int ImportCommand::run() const {
               << r.particle_count << " nodes, " << r.mesh->tet_count() << " tetrahedra x " << r.frame_count()
               << " frames over " << number(r.frame_times_s[last] - r.frame_times_s[0]) << " s, compression to "
               << number(1e3 * compression) << " mm (strain " << number(compression / t.height_m) << "), load "
-              << number(-r.wrench[last].force_n[2]) << " N, " << host::to_string(options.platen_contact)
-              << " platens";
+              << number(-r.wrench[last].force_n[2]) << " N, " << host::to_string(options.platen_contact) << " platens";
     try {
       const host::LinearModulusFit fit = host::fit_linear_modulus(t, 0.02, 0.10);
       std::cout << "; linear modulus 2-10 % strain " << number(fit.youngs_modulus_pa * 1e-3) << " kPa";

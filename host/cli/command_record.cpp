@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "atomic_write.hpp"
+#include "cli_registry.hpp"
 #include "exit_status.hpp"
 #include "pliant/hal/clock.hpp"
 #include "pliant/host/recording.hpp"
@@ -24,11 +25,8 @@
 #include "record_devices.hpp"
 #include "record_output.hpp"
 #include "record_particles.hpp"
+#include "record_track.hpp"
 #include "record_writer.hpp"
-
-#if PLIANT_HAVE_OPENCV
-#include <opencv2/core/utils/logger.hpp>
-#endif
 
 namespace pliant::cli {
 namespace {
@@ -168,10 +166,10 @@ RecordCommand::RecordCommand(CLI::App& parent) {
   app_->add_option("--gripper", gripper_, "Parallel gripper (read only: never commanded)")->type_name("SPEC");
   app_->add_option("--duration", duration_s_, "Stop after this many seconds (default: Ctrl-C or end of files)")
       ->type_name("S");
-  auto* roi = app_->add_option("--roi", track_.roi, "Track particles in this region of the colour video")
-                  ->type_name("X,Y,W,H");
-  auto* mask = app_->add_option("--mask", track_.mask, "Track particles in this mask (non-zero inside)")
-                   ->type_name("PNG");
+  auto* roi =
+      app_->add_option("--roi", track_.roi, "Track particles in this region of the colour video")->type_name("X,Y,W,H");
+  auto* mask =
+      app_->add_option("--mask", track_.mask, "Track particles in this mask (non-zero inside)")->type_name("PNG");
   roi->excludes(mask);
   mask->excludes(roi);
   app_->add_option("--grid", track_.grid, "Particle grid ROWSxCOLS (as pliant track; default 4x8)")->type_name("RxC");
@@ -186,7 +184,8 @@ RecordCommand::RecordCommand(CLI::App& parent) {
       ->type_name("SPEC")
       ->capture_default_str();
   app_->add_flag("--tare", tare_, "Zero the force/torque sensor when the recording starts");
-  app_->add_option("--gripper-stroke", gripper_stroke_m_, "Robotiq opening at full stroke, m (2F-85: 0.085, 2F-140: 0.140)")
+  app_->add_option("--gripper-stroke", gripper_stroke_m_,
+                   "Robotiq opening at full stroke, m (2F-85: 0.085, 2F-140: 0.140)")
       ->type_name("M")
       ->capture_default_str()
       ->check(CLI::Range(0.001, 1.0));
@@ -196,9 +195,8 @@ RecordCommand::RecordCommand(CLI::App& parent) {
 }
 
 int RecordCommand::run() const {
-#if PLIANT_HAVE_OPENCV
-  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR);  // our own one-line messages only
-#endif
+  const CliRegistry& parts = cli_registry();
+  for (const auto& quiet : parts.quiet_logs) quiet();  // our own one-line messages only
   // 1. Everything that can be checked without a device.
   if (app_->count("--duration") > 0 && !(std::isfinite(duration_s_) && duration_s_ > 0)) {
     throw UsageError("--duration: must be a positive number of seconds, found " + number(duration_s_));
@@ -207,26 +205,24 @@ int RecordCommand::run() const {
   if (specs.empty()) throw UsageError("give at least one device: --color, --depth, --ft or --gripper");
   const bool color = has_role(specs, DeviceRole::color);
   const bool frames = color || has_role(specs, DeviceRole::depth);
-#if !PLIANT_HAVE_OPENCV
-  if (frames) throw UsageError("recording colour or depth frames needs OpenCV; install libopencv-dev and rebuild");
-#endif
+  if (frames && !parts.media) {
+    throw UsageError("recording colour or depth frames needs OpenCV; install libopencv-dev and rebuild");
+  }
   for (const char* option : {"--grid", "--spacing", "--flow", "--support", "--driven"}) {
     if (app_->count(option) > 0 && !track_.requested()) {
       throw UsageError(std::string(option) + " is a tracking option: give --roi or --mask too");
     }
   }
   const bool tracked = track_.requested();
-#if PLIANT_HAVE_VISION_WEBCAM
   std::unique_ptr<VideoTracking> tracking;
-#endif
   if (tracked) {
     if (!color) throw UsageError("--roi/--mask track the colour video: give --color too");
-#if PLIANT_HAVE_VISION_WEBCAM
-    tracking = std::make_unique<VideoTracking>(track_);
-#else
-    throw UsageError("this pliant was built without the webcam front end (host/vision/webcam); install "
-                     "libopencv-dev and rebuild");
-#endif
+    if (!parts.tracking) {
+      throw UsageError(
+          "this pliant was built without the webcam front end (host/vision/webcam); install "
+          "libopencv-dev and rebuild");
+    }
+    tracking = parts.tracking(track_);
   } else if (!has_role(specs, DeviceRole::gripper)) {
     throw UsageError(
         "no source of particles: give --color with --roi or --mask (particles tracked in the video), or "
@@ -254,11 +250,9 @@ int RecordCommand::run() const {
   RecordWriter writer(output.partial(), t0, frames);
   CaptureOptions capture;
   capture.duration_s = duration_s_;
-#if PLIANT_HAVE_VISION_WEBCAM
   if (tracking) {
     capture.on_first_color = [&tracking](const hal::ColorFrame& f) { tracking->check_frame_size(f.width, f.height); };
   }
-#endif
   if (!quiet_) {
     std::cerr << "pliant record: recording " << specs.size() << " device(s) into " << output.target()
               << (duration_s_ > 0 ? " for " + number(duration_s_) + " s" : std::string()) << "; Ctrl-C stops\n";
@@ -296,7 +290,6 @@ int RecordCommand::run() const {
   // 4. The particles and the recording.
   host::Recording recording;
   std::string track_csv;
-#if PLIANT_HAVE_VISION_WEBCAM
   if (tracking) {
     if (writer.color_times().size() < 2) {
       throw std::runtime_error("the colour source gave " + std::to_string(writer.color_times().size()) +
@@ -306,7 +299,6 @@ int RecordCommand::run() const {
                                 output.name(), track_csv, !quiet_);
     recording.meta["track"]["source"] = "color.avi";  // not the temporary directory it was tracked in
   }
-#endif
   if (!tracked) recording = jaw_recording(writer.gripper(), output.name());
   if (!writer.wrench().empty()) {
     recording.wrench = writer.wrench();

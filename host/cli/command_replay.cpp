@@ -65,15 +65,19 @@ nlohmann::json summary_json(const host::ReplaySummary& s) {
     const hal::DeviceCounters& c = ds.counters;
     nlohmann::json injected = nlohmann::json::object();
     for (int k = 0; k < hal::kFaultKindCount; ++k) {
-      if (ds.injected.injected[k] > 0) injected[hal::fault_kind_name(static_cast<hal::FaultKind>(k))] = ds.injected.injected[k];
+      if (ds.injected.injected[k] > 0)
+        injected[hal::fault_kind_name(static_cast<hal::FaultKind>(k))] = ds.injected.injected[k];
     }
     devices[host::replay_device_name(static_cast<host::ReplayDevice>(d))] = {
-        {"samples", c.samples},         {"dropped", c.dropped},     {"fault_samples", c.fault_samples},
-        {"timeouts", c.timeouts},       {"bus_off", c.bus_off},     {"disconnected", c.disconnected},
+        {"samples", c.samples},         {"dropped", c.dropped},       {"fault_samples", c.fault_samples},
+        {"timeouts", c.timeouts},       {"bus_off", c.bus_off},       {"disconnected", c.disconnected},
         {"disconnects", c.disconnects}, {"reconnects", c.reconnects}, {"injected", injected}};
   }
-  nlohmann::json j = {{"summary", {{"devices", devices}, {"duration", s.duration_s}, {"interrupted", s.interrupted},
-                                   {"skipped_rows", s.skipped_rows}}}};
+  nlohmann::json j = {{"summary",
+                       {{"devices", devices},
+                        {"duration", s.duration_s},
+                        {"interrupted", s.interrupted},
+                        {"skipped_rows", s.skipped_rows}}}};
   if (s.estimated) {
     j["summary"]["estimate"] = {{"msm_beta", number(s.estimate.msm_beta)},
                                 {"msm_beta_std", number(s.estimate.msm_beta_std)},

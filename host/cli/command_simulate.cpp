@@ -45,8 +45,8 @@ std::string number(double value) {
 
 SimulateCommand::SimulateCommand(CLI::App& parent) {
   app_ = parent.add_subcommand("simulate", "Write a simulated recording with known msm_beta (and its truth.json)");
-  app_->footer("Scenarios: " + joined(host::scenario_names()) + ".\nEffects for --effect, with their defaults: " +
-               host::describe_effects() +
+  app_->footer("Scenarios: " + joined(host::scenario_names()) +
+               ".\nEffects for --effect, with their defaults: " + host::describe_effects() +
                ".\nThe recording never mentions the effect, the substeps, the cluster radius or the occlusion; "
                "truth.json holds them with the true parameters, for checking. No estimator reads it.");
   app_->add_option("SCENARIO", scenario_, "One of: " + joined(host::scenario_names()))->required();
@@ -63,11 +63,10 @@ SimulateCommand::SimulateCommand(CLI::App& parent) {
   app_->add_option("--seed", options_.seed, "Noise seed (>= 0)")
       ->type_name("S")
       ->check(CLI::Validator(
-          [](std::string& value) { return value.rfind('-', 0) == 0 ? std::string("must be >= 0") : std::string(); },
-          "", "non-negative"))
+          [](std::string& value) { return value.rfind('-', 0) == 0 ? std::string("must be >= 0") : std::string(); }, "",
+          "non-negative"))
       ->capture_default_str();
-  app_->add_option("--rate", options_.rate_hz, "Frames per second (default: the scenario's own rate)")
-      ->type_name("HZ");
+  app_->add_option("--rate", options_.rate_hz, "Frames per second (default: the scenario's own rate)")->type_name("HZ");
   // Parsed in run(), where a bad name becomes a usage error naming the valid ones.
   app_->add_option("--effect", options_.effect,
                    "Concealed effect switched on in the simulation, with optional parameters, e.g. "
@@ -115,9 +114,9 @@ int SimulateCommand::run() const {
   const host::Recording& rec = scenario.recording;
   // The summary names what is visible in the recording; the effect stays in truth.json.
   std::cout << "wrote " << output_ << ": " << scenario_ << ", " << rec.particle_count << " particles x "
-            << rec.frame_count() << " frames (" << rec.dimension << "D, " << rec.length_unit
-            << "), msm_beta " << number(options_.msm_beta) << ", msm_alpha " << number(options_.msm_alpha)
-            << ", noise " << number(options_.noise) << ", seed " << options_.seed << "; truth in truth.json\n";
+            << rec.frame_count() << " frames (" << rec.dimension << "D, " << rec.length_unit << "), msm_beta "
+            << number(options_.msm_beta) << ", msm_alpha " << number(options_.msm_alpha) << ", noise "
+            << number(options_.noise) << ", seed " << options_.seed << "; truth in truth.json\n";
   return exit_ok;
 }
 

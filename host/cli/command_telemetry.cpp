@@ -63,9 +63,9 @@ std::unique_ptr<tm::ByteSource> open_source(const CLI::App& app, const std::stri
 }
 
 std::string frame_summary(const tm::ParticleFrameCounts& c) {
-  return "particle frames " + std::to_string(c.kept) + " kept, " + std::to_string(c.dropped()) + " dropped (incomplete " +
-         std::to_string(c.incomplete) + ", before_rest " + std::to_string(c.before_rest) + ", shape " +
-         std::to_string(c.shape) + ", time " + std::to_string(c.time) + ")";
+  return "particle frames " + std::to_string(c.kept) + " kept, " + std::to_string(c.dropped()) +
+         " dropped (incomplete " + std::to_string(c.incomplete) + ", before_rest " + std::to_string(c.before_rest) +
+         ", shape " + std::to_string(c.shape) + ", time " + std::to_string(c.time) + ")";
 }
 
 }  // namespace
@@ -98,8 +98,8 @@ TelemetryCommand::TelemetryCommand(CLI::App& parent) {
       ->type_name("ADDR")
       ->capture_default_str()
       ->needs(udp);
-  auto* output = app_->add_option("-o,--output", output_, "JSON lines file (default: standard output)")
-                     ->type_name("OUT.jsonl");
+  auto* output =
+      app_->add_option("-o,--output", output_, "JSON lines file (default: standard output)")->type_name("OUT.jsonl");
   auto* recording = app_->add_option("--recording", recording_, "Write a recording directory instead of JSON lines")
                         ->type_name("DIR");
   output->excludes(recording);

@@ -37,19 +37,20 @@ std::string id_list(const std::vector<int>& ids) {
 }  // namespace
 
 TrackCommand::TrackCommand(CLI::App& parent) {
-  app_ = parent.add_subcommand("track", "Track particles on an object in a video by optical flow into a recording (px)");
+  app_ =
+      parent.add_subcommand("track", "Track particles on an object in a video by optical flow into a recording (px)");
   app_->footer(
       "Particles are seeded on a grid in the region of the first frame, advected by the dense flow averaged "
       "over a window around each (forward-backward and appearance checked), and corrected by the "
       "MSM-regularised tracker. The support and the driven (tool) particle are detected from the motion "
       "unless given. Exit status: 0 ok, 1 runtime failure, 2 bad options or unusable input (unreadable "
       "video, empty region, frames of different sizes); nothing is written unless tracking succeeds.");
-  app_->add_option("INPUT", input_,
-                   "Video file, printf-style image pattern (frames/f_%04d.png) or glob (frames/*.png)")
+  app_->add_option("INPUT", input_, "Video file, printf-style image pattern (frames/f_%04d.png) or glob (frames/*.png)")
       ->required();
-  auto* roi = app_->add_option("--roi", roi_, "Region of the first frame: x,y,width,height in pixels")->type_name("X,Y,W,H");
-  auto* mask = app_->add_option("--mask", mask_, "Region as a mask image (non-zero inside), the frames' size")
-                   ->type_name("PNG");
+  auto* roi =
+      app_->add_option("--roi", roi_, "Region of the first frame: x,y,width,height in pixels")->type_name("X,Y,W,H");
+  auto* mask =
+      app_->add_option("--mask", mask_, "Region as a mask image (non-zero inside), the frames' size")->type_name("PNG");
   roi->excludes(mask);
   mask->excludes(roi);
   app_->add_option("--grid", grid_, "Particle grid ROWSxCOLS (default 4x8 when --spacing is not given)")
@@ -130,8 +131,8 @@ int TrackCommand::run() const {
     const webcam::ParticleRoles& roles = result.roles;
     std::ostringstream out;
     out << "wrote " << output_ << ": " << result.particle_count() << " particles (" << result.grid.rows << "x"
-        << result.grid.cols << " grid) x " << result.frame_count() << " frames at " << number(result.rate_hz)
-        << " Hz, " << webcam::flow_method_name(result.options.flow) << " flow\n";
+        << result.grid.cols << " grid) x " << result.frame_count() << " frames at " << number(result.rate_hz) << " Hz, "
+        << webcam::flow_method_name(result.options.flow) << " flow\n";
     out << "support: " << id_list(roles.support)
         << (roles.support_detected ? std::string(" (detected: ") + webcam::grid_side_name(roles.support_side) + " side)"
                                    : std::string(" (given)"))

@@ -78,8 +78,12 @@ TrackDepthCommand::TrackDepthCommand(CLI::App& parent) {
                    "in the camera frame)")
       ->type_name("TX,TY,TZ,QX,QY,QZ,QW");
   app_->add_option("--region", region_, "Pixel region of interest (default: the whole image)")->type_name("U0,V0,W,H");
-  app_->add_option("--stride", stride_, "Use every N-th pixel along rows and columns")->type_name("N")->capture_default_str();
-  app_->add_option("--min-depth", min_depth_m_, "Drop points nearer than this, m")->type_name("M")->capture_default_str();
+  app_->add_option("--stride", stride_, "Use every N-th pixel along rows and columns")
+      ->type_name("N")
+      ->capture_default_str();
+  app_->add_option("--min-depth", min_depth_m_, "Drop points nearer than this, m")
+      ->type_name("M")
+      ->capture_default_str();
   app_->add_option("--max-depth", max_depth_m_, "Drop points farther than this, m (0: no limit)")
       ->type_name("M")
       ->capture_default_str();
@@ -88,10 +92,13 @@ TrackDepthCommand::TrackDepthCommand(CLI::App& parent) {
                    "'point': the mean of its nearest cloud points")
       ->type_name("plane|point")
       ->capture_default_str();
-  app_->add_option("--noise", noise_m_, "Depth noise sd at the object's distance, m (floor of the correspondence scale)")
+  app_->add_option("--noise", noise_m_,
+                   "Depth noise sd at the object's distance, m (floor of the correspondence scale)")
       ->type_name("M")
       ->capture_default_str();
-  app_->add_option("--msm-beta", msm_beta_, "The tracker's prior msm_beta, in [0, 1]")->type_name("B")->capture_default_str();
+  app_->add_option("--msm-beta", msm_beta_, "The tracker's prior msm_beta, in [0, 1]")
+      ->type_name("B")
+      ->capture_default_str();
   app_->add_option("--rounds", rounds_,
                    "Track, estimate msm_beta, track again with it as the prior, ... up to N rounds (1: track once)")
       ->type_name("N")
@@ -117,14 +124,17 @@ int TrackDepthCommand::run() const {
   if (max_depth_m_ > 0 && !(max_depth_m_ > min_depth_m_)) throw UsageError("--max-depth must exceed --min-depth");
   if (!(std::isfinite(noise_m_) && noise_m_ > 0)) throw UsageError("--noise must be > 0");
   if (!(msm_beta_ >= 0 && msm_beta_ <= 1)) throw UsageError("--msm-beta must be in [0, 1]");
-  if (rounds_ < 1 || rounds_ > max_rounds) throw UsageError("--rounds must be between 1 and " + std::to_string(max_rounds));
+  if (rounds_ < 1 || rounds_ > max_rounds)
+    throw UsageError("--rounds must be between 1 and " + std::to_string(max_rounds));
   if (reference_frames_ < 0) throw UsageError("--reference-frames must be >= 0");
   if (!std::isfinite(time_offset_s_)) throw UsageError("--time-offset must be finite");
-  if (correspondence_ != "plane" && correspondence_ != "point") throw UsageError("--correspondence must be plane or point");
+  if (correspondence_ != "plane" && correspondence_ != "point")
+    throw UsageError("--correspondence must be plane or point");
   const std::string plan_dir = positionals_.size() == 2 ? positionals_.front() : std::string();
   const std::string depth_path = positionals_.back();
   const bool seeding = app_->count("--seed-spacing") > 0;
-  if (seeding && !(std::isfinite(seed_spacing_m_) && seed_spacing_m_ > 0)) throw UsageError("--seed-spacing must be > 0 m");
+  if (seeding && !(std::isfinite(seed_spacing_m_) && seed_spacing_m_ > 0))
+    throw UsageError("--seed-spacing must be > 0 m");
   if (seeding && !plan_dir.empty()) throw UsageError("give either PLAN or --seed-spacing, not both");
   if (!seeding && plan_dir.empty()) throw UsageError("give PLAN (a recording of the particles) or --seed-spacing M");
   check_output_directory(output_, force_);
@@ -214,7 +224,8 @@ int TrackDepthCommand::run() const {
     std::cout << "wrote " << output_ << ": " << plan.particle_count << " particles x " << times.size() << " frames ("
               << (options.observed_only ? "observed positions only" : "every tracked position") << ")\n";
     std::cout << "first frame: " << a.observed << " of " << lookable
-              << " surface particles found on the cloud, median distance " << number(1e3 * a.median_distance_m) << " mm\n";
+              << " surface particles found on the cloud, median distance " << number(1e3 * a.median_distance_m)
+              << " mm\n";
     std::cout << "per frame: " << number(static_cast<double>(points) / updates, "%.0f") << " points, "
               << number(static_cast<double>(observed) / updates, "%.1f") << " particles observed; "
               << result.calibration_frames << " calibration frames, " << result.counters.empty_frames
@@ -222,16 +233,18 @@ int TrackDepthCommand::run() const {
     std::cout << "particle-frames by view:";
     for (int v = 0; v < vision::kParticleViewCount; ++v) {
       const std::uint64_t count = result.counters.by_view[static_cast<std::size_t>(v)];
-      if (count > 0) std::cout << ' ' << vision::particle_view_name(static_cast<vision::ParticleView>(v)) << ' ' << count;
+      if (count > 0)
+        std::cout << ' ' << vision::particle_view_name(static_cast<vision::ParticleView>(v)) << ' ' << count;
     }
     std::cout << '\n';
     for (std::size_t r = 0; r < estimates.size(); ++r) {
-      std::cout << "round " << r + 1 << ": prior msm_beta " << number(priors[r]) << " -> estimate " << number(estimates[r])
-                << '\n';
+      std::cout << "round " << r + 1 << ": prior msm_beta " << number(priors[r]) << " -> estimate "
+                << number(estimates[r]) << '\n';
     }
     if (lookable > 0 && a.observed * 4 < lookable) {
-      report_warning("few particles lie on the first frame's surface: check --camera-pose, --intrinsics and "
-                     "--units-per-metre");
+      report_warning(
+          "few particles lie on the first frame's surface: check --camera-pose, --intrinsics and "
+          "--units-per-metre");
     }
   } catch (const vision::DepthError& error) {
     throw UsageError(error.what());

@@ -1,5 +1,6 @@
 // `pliant track-depth PLAN DEPTH -o DIR` (or `--seed-spacing M DEPTH` without a plan): a depth
-// image sequence (TUM list, `pliant record` depth_frames.csv, .oni) tracked into a 3D recording (host/vision/depth, docs/vision_depth.md).
+// image sequence (TUM list, `pliant record` depth_frames.csv, .oni) tracked into a 3D recording (host/vision/depth,
+// docs/vision_depth.md).
 #pragma once
 
 #include <string>

@@ -112,8 +112,8 @@ std::string format_estimate_summary(const host::Recording& recording, const host
   const std::string& unit = recording.length_unit;
   const bool alpha_estimated = options.estimate_alpha && options.mode == FitMode::trajectory;
   std::string text;
-  text += format("recording   %s: %d particles, %d frames, %dD, %s\n", recording.name.c_str(),
-                 recording.particle_count, recording.frame_count(), recording.dimension, unit.c_str());
+  text += format("recording   %s: %d particles, %d frames, %dD, %s\n", recording.name.c_str(), recording.particle_count,
+                 recording.frame_count(), recording.dimension, unit.c_str());
   text += format("mode        %s\n", host::fit_mode_name(options.mode));
   text += format("msm_beta    %.3f ", r.msm_beta) + uncertainty_text(report.msm_beta_std) + "\n";
   if (std::isfinite(report.msm_beta_std)) {

@@ -30,7 +30,7 @@ enum class StopReason { duration, interrupted, sources_ended };
 const char* stop_reason_name(StopReason reason) noexcept;
 
 struct CaptureOptions {
-  double duration_s = 0;       ///< 0: no limit
+  double duration_s = 0;        ///< 0: no limit
   double idle_sleep_s = 0.001;  ///< sleep after a pass that brought nothing
   /// Called with the first colour frame the writer kept (may throw to abort).
   std::function<void(const hal::ColorFrame&)> on_first_color;

@@ -19,24 +19,33 @@ struct KindEntry {
   DeviceRole role;
   const char* form;     // expected form
   const char* example;  // an example spec
+  const char* driver;   // the drivers/ folder that opens it
+  const char* package;  // the Debian package that driver needs
 };
 
 constexpr KindEntry kKinds[] = {
-    {"v4l2", DeviceKind::v4l2, DeviceRole::color, "v4l2:/dev/videoN or v4l2:N", "v4l2:/dev/video0"},
-    {"video", DeviceKind::video, DeviceRole::color, "video:FILE", "video:take1.avi"},
-    {"images", DeviceKind::images, DeviceRole::color, "images:PATTERN", "images:frames/f_%04d.png"},
-    {"libcamera", DeviceKind::libcamera, DeviceRole::color, "libcamera:any or libcamera:ID", "libcamera:any"},
-    {"openni2", DeviceKind::openni2, DeviceRole::depth, "openni2:any or openni2:URI", "openni2:any"},
-    {"oni", DeviceKind::oni, DeviceRole::depth, "oni:FILE", "oni:take1.oni"},
-    {"ati-can", DeviceKind::ati_can, DeviceRole::ft, "ati-can:IFACE@0xBASE", "ati-can:can0@0x20"},
+    {"v4l2", DeviceKind::v4l2, DeviceRole::color, "v4l2:/dev/videoN or v4l2:N", "v4l2:/dev/video0", "opencv",
+     "libopencv-dev"},
+    {"video", DeviceKind::video, DeviceRole::color, "video:FILE", "video:take1.avi", "opencv", "libopencv-dev"},
+    {"images", DeviceKind::images, DeviceRole::color, "images:PATTERN", "images:frames/f_%04d.png", "opencv",
+     "libopencv-dev"},
+    {"libcamera", DeviceKind::libcamera, DeviceRole::color, "libcamera:any or libcamera:ID", "libcamera:any",
+     "libcamera", "libcamera-dev"},
+    {"openni2", DeviceKind::openni2, DeviceRole::depth, "openni2:any or openni2:URI", "openni2:any", "openni2",
+     "libopenni2-dev"},
+    {"oni", DeviceKind::oni, DeviceRole::depth, "oni:FILE", "oni:take1.oni", "openni2", "libopenni2-dev"},
+    {"ati-can", DeviceKind::ati_can, DeviceRole::ft, "ati-can:IFACE@0xBASE", "ati-can:can0@0x20", "socketcan",
+     "linux-libc-dev"},
     {"robotous-can", DeviceKind::robotous_can, DeviceRole::ft, "robotous-can:IFACE@0xCMD[,0xRESP1,0xRESP2]",
-     "robotous-can:can0@0x64"},
-    {"ft300-rtu", DeviceKind::ft300_rtu, DeviceRole::ft, "ft300-rtu:DEV[@SLAVE]", "ft300-rtu:/dev/ttyUSB1"},
-    {"ft300-tcp", DeviceKind::ft300_tcp, DeviceRole::ft, "ft300-tcp:HOST:PORT[@SLAVE]", "ft300-tcp:192.168.1.11:502"},
-    {"robotiq-rtu", DeviceKind::robotiq_rtu, DeviceRole::gripper, "robotiq-rtu:DEV[@SLAVE]",
-     "robotiq-rtu:/dev/ttyUSB0"},
+     "robotous-can:can0@0x64", "socketcan", "linux-libc-dev"},
+    {"ft300-rtu", DeviceKind::ft300_rtu, DeviceRole::ft, "ft300-rtu:DEV[@SLAVE]", "ft300-rtu:/dev/ttyUSB1", "modbus",
+     "libmodbus-dev"},
+    {"ft300-tcp", DeviceKind::ft300_tcp, DeviceRole::ft, "ft300-tcp:HOST:PORT[@SLAVE]", "ft300-tcp:192.168.1.11:502",
+     "modbus", "libmodbus-dev"},
+    {"robotiq-rtu", DeviceKind::robotiq_rtu, DeviceRole::gripper, "robotiq-rtu:DEV[@SLAVE]", "robotiq-rtu:/dev/ttyUSB0",
+     "modbus", "libmodbus-dev"},
     {"robotiq-tcp", DeviceKind::robotiq_tcp, DeviceRole::gripper, "robotiq-tcp:HOST:PORT[@SLAVE]",
-     "robotiq-tcp:192.168.1.11:502"},
+     "robotiq-tcp:192.168.1.11:502", "modbus", "libmodbus-dev"},
 };
 
 const KindEntry& entry_of(DeviceKind kind) {
@@ -291,6 +300,10 @@ const char* device_role_option(DeviceRole role) noexcept {
 const char* device_role_name(DeviceRole role) noexcept { return device_role_option(role) + 2; }
 
 const char* device_kind_name(DeviceKind kind) noexcept { return entry_of(kind).word; }
+
+const char* device_kind_driver(DeviceKind kind) noexcept { return entry_of(kind).driver; }
+
+const char* device_kind_package(DeviceKind kind) noexcept { return entry_of(kind).package; }
 
 bool is_file_backed(DeviceKind kind) noexcept {
   return kind == DeviceKind::video || kind == DeviceKind::images || kind == DeviceKind::oni;

@@ -1,6 +1,9 @@
 // Device specs of `pliant record`: the text KIND:LOCATION after --color, --depth, --ft and
 // --gripper, parsed into a struct. Pure: no I/O, no device is touched (whether a file exists or
-// an interface is up is found out when the device is opened, record_devices.hpp).
+// an interface is up is found out when the device is opened, record_devices.hpp). Every kind is
+// parsed whether or not its driver was built; record_devices.hpp turns a spec into the generic
+// hal::DeviceSpec its driver registered (hal/device_registry.hpp) and refuses kinds whose driver
+// this build lacks.
 //
 //   --color    v4l2:/dev/videoN | v4l2:N | v4l2:/dev/v4l/by-id/...   a V4L2 webcam (drivers/opencv)
 //              video:FILE                 a video file, played in real time (drivers/opencv)
@@ -58,17 +61,17 @@ inline constexpr int kDefaultModbusSlave = 9;
 struct DeviceSpec {
   DeviceRole role = DeviceRole::color;
   DeviceKind kind = DeviceKind::video;
-  std::string text;      ///< the spec as given (for messages and recording.json)
+  std::string text;  ///< the spec as given (for messages and recording.json)
   /// v4l2: "/dev/..." or the index digits; video, images, oni: the path or pattern; libcamera:
   /// the camera id ("" for any); openni2: the URI or "any"; CAN kinds: the interface; *-rtu:
   /// the serial device; *-tcp: the IPv4 host.
   std::string location;
-  bool any = false;                 ///< libcamera:any, openni2:any
-  std::uint32_t can_id = 0;         ///< ati-can: base ID; robotous-can: command ID
+  bool any = false;                     ///< libcamera:any, openni2:any
+  std::uint32_t can_id = 0;             ///< ati-can: base ID; robotous-can: command ID
   std::uint32_t can_response_1 = 0x01;  ///< robotous-can
   std::uint32_t can_response_2 = 0x02;  ///< robotous-can
-  int port = 0;                     ///< *-tcp
-  int slave_id = kDefaultModbusSlave;  ///< Modbus kinds
+  int port = 0;                         ///< *-tcp
+  int slave_id = kDefaultModbusSlave;   ///< Modbus kinds
 };
 
 class DeviceSpecError : public std::invalid_argument {
@@ -83,8 +86,12 @@ DeviceSpec parse_device_spec(DeviceRole role, std::string_view text);
 const char* device_role_option(DeviceRole role) noexcept;
 /// "color", "depth", "ft", "gripper" (keys in recording.json meta.devices).
 const char* device_role_name(DeviceRole role) noexcept;
-/// The KIND word of a spec ("v4l2", "ati-can", ...).
+/// The KIND word of a spec ("v4l2", "ati-can", ...): the scheme its driver registers.
 const char* device_kind_name(DeviceKind kind) noexcept;
+/// The drivers/ folder that opens a kind ("opencv", "socketcan", ...), and the Debian package
+/// that driver needs ("libopencv-dev", ...): what to install when a build lacks it.
+const char* device_kind_driver(DeviceKind kind) noexcept;
+const char* device_kind_package(DeviceKind kind) noexcept;
 /// True for sources that play a file (video, images, oni): they end on their own.
 bool is_file_backed(DeviceKind kind) noexcept;
 

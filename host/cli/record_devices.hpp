@@ -1,25 +1,23 @@
-// `pliant record`: the devices of a recording, opened through the drivers that were built.
+// `pliant record`: the devices of a recording, opened through the device registry
+// (hal/device_registry.hpp) that the drivers of this build registered in (cli_registry.hpp).
 //
-// Each driver is optional in the build (drivers/CMakeLists.txt leaves out those whose library
-// is missing); host/cli/CMakeLists.txt defines PLIANT_HAVE_DRIVER_<NAME> for those present, and
-// only their code is compiled here. A spec for a driver that is not built is refused by
-// check_driver_built() with the Debian package to install.
+// A spec (record_device_spec.hpp) becomes the hal::DeviceSpec its driver registered: the KIND is
+// the scheme, the numbers of the spec and the options below are parameters. The recorder asks
+//   colour    format bgr8 (what cv::VideoWriter takes); files play in real time, so a file
+//             behaves as a camera on the recording clock
+//   depth     .oni files play in real time
+//   ft        tare when --tare (ATI: 100 samples on start; Robotous: the sensor's bias on start;
+//             FT 300: the first sample)
+//   gripper   stroke_m from --gripper-stroke
+// and leaves the rest to the factories (docs/hal.md lists them: FT 300 stream mode on RTU,
+// polled at most every 5 ms over TCP; Robotiq polled at most every 10 ms with activation policy
+// `never`: the recorder only reads, it never activates or moves the fingers).
+// A spec whose driver this build lacks is refused by check_driver_built() with the Debian
+// package to install.
 //
-// What the recorder asks of the drivers (chosen here, documented in docs/record.md):
-//   colour    OpenCvCamera (bgr8; files in real-time playback, so a file behaves as a camera
-//             on the recording clock), LibcameraCamera (bgr8)
-//   depth     Openni2Camera (devices; .oni files in real-time playback)
-//   ft        AtiNetCanForceTorque and RobotousRftForceTorque on a RawCanTransport;
-//             RobotiqFt300 in stream mode over a serial port, polled over Modbus TCP (at most
-//             every 5 ms)
-//   gripper   RobotiqGripper with ActivationPolicy::never and a 10 ms poll period: the
-//             recorder only reads; it never activates or moves the fingers.
-//   --tare    ATI: 100 samples on start; Robotous: the sensor's bias on start; FT 300: the
-//             first sample.
-//
-// Lifecycle: open_device() constructs and configures; start(); the loop reads through the HAL
-// interfaces; the destructor stops (if active) and cleans up. Errors: configure refused with
-// invalid_argument -> UsageError (exit 2); any other configure or start failure ->
+// Lifecycle: open_device() constructs and configures (the factory); start(); the loop reads
+// through the HAL interfaces; the destructor stops (if active) and cleans up. Errors: configure
+// refused with invalid_argument -> UsageError (exit 2); any other configure or start failure ->
 // std::runtime_error (exit 1). Both name the option, the spec and the driver's reason.
 // Host code: allocates and throws. Thread safety: one thread drives the devices.
 #pragma once
@@ -31,6 +29,7 @@
 
 #include "pliant/hal/camera.hpp"
 #include "pliant/hal/clock.hpp"
+#include "pliant/hal/device_registry.hpp"
 #include "pliant/hal/force_torque.hpp"
 #include "pliant/hal/gripper.hpp"
 #include "record_device_spec.hpp"
@@ -38,43 +37,45 @@
 namespace pliant::cli {
 
 struct DeviceOpenOptions {
-  bool tare = false;              ///< zero the F/T sensor at start (see the top)
+  bool tare = false;                ///< zero the F/T sensor at start (see the top)
   double gripper_stroke_m = 0.085;  ///< Robotiq 2F: 0.085 (2F-85) or 0.140 (2F-140), the width at full opening
 };
 
 /// One opened device. Exactly one of color(), depth(), ft(), gripper() is non-null, by role.
 class RecordDevice {
  public:
-  virtual ~RecordDevice() = default;
+  RecordDevice(DeviceSpec spec, std::string driver, std::unique_ptr<hal::OpenedDevice> opened);
   RecordDevice(const RecordDevice&) = delete;
   RecordDevice& operator=(const RecordDevice&) = delete;
 
   const DeviceSpec& spec() const { return spec_; }
   /// "opencv", "libcamera", "openni2", "socketcan", "modbus".
-  virtual const char* driver() const = 0;
-  virtual hal::Device& device() = 0;
-  virtual hal::ColorCamera* color() { return nullptr; }
-  virtual hal::DepthCamera* depth() { return nullptr; }
-  virtual hal::ForceTorqueSensor* ft() { return nullptr; }
-  virtual hal::Gripper* gripper() { return nullptr; }
+  const char* driver() const { return driver_.c_str(); }
+  hal::Device& device() { return opened_->device(); }
+  hal::ColorCamera* color() { return opened_->color_camera(); }
+  hal::DepthCamera* depth() { return opened_->depth_camera(); }
+  hal::ForceTorqueSensor* ft() { return opened_->force_torque(); }
+  hal::Gripper* gripper() { return opened_->gripper(); }
 
   /// inactive -> active, plus what must follow it (FT 300 tare). Throws std::runtime_error.
   void start();
   /// File-backed sources: true once every frame was delivered or dropped.
-  virtual bool ended() const { return false; }
-  /// Driver counters and facts for recording.json meta (JSON object).
-  virtual nlohmann::json driver_info() const { return nlohmann::json::object(); }
-
- protected:
-  explicit RecordDevice(DeviceSpec spec) : spec_(std::move(spec)) {}
-  /// Called after a successful start().
-  virtual void after_start() {}
-  /// Stops and cleans up whatever state the device is in (for destructors).
-  void shut_down() noexcept;
+  bool ended() const { return opened_->ended(); }
+  /// Driver counters and facts for recording.json meta (JSON object; hal::DeviceInfo's dotted
+  /// names nested).
+  nlohmann::json driver_info() const;
 
  private:
   DeviceSpec spec_;
+  std::string driver_;
+  std::unique_ptr<hal::OpenedDevice> opened_;  // stops and cleans up the device when destroyed
 };
+
+/// The device category of a role.
+hal::DeviceCategory device_category(DeviceRole role) noexcept;
+
+/// The hal::DeviceSpec of `spec` with `options` as parameters (see the top).
+hal::DeviceSpec to_hal_spec(const DeviceSpec& spec, const DeviceOpenOptions& options);
 
 /// Throws UsageError when the driver of `spec` is not part of this build, naming the Debian
 /// package that brings it ("... install libopenni2-dev and rebuild").

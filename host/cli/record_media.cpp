@@ -14,11 +14,13 @@
 #include <utility>
 
 #include <opencv2/core.hpp>
+#include <opencv2/core/utils/logger.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
 #include "atomic_write.hpp"
+#include "cli_registry.hpp"
 
 namespace pliant::cli {
 namespace {
@@ -236,8 +238,8 @@ struct MediaWriter::Impl {
       std::ostringstream csv;
       csv << "index,t,file,depth_scale_m,fx,fy,cx,cy\n";
       for (const DepthFrameRow& r : depth_rows) {
-        csv << r.index << ',' << number(r.t_s) << ',' << r.file << ',' << number(r.depth_scale_m) << ','
-            << number(r.fx) << ',' << number(r.fy) << ',' << number(r.cx) << ',' << number(r.cy) << '\n';
+        csv << r.index << ',' << number(r.t_s) << ',' << r.file << ',' << number(r.depth_scale_m) << ',' << number(r.fx)
+            << ',' << number(r.fy) << ',' << number(r.cx) << ',' << number(r.cy) << '\n';
       }
       write_file_atomically((fs::path(directory) / kDepthFrames).string(), csv.str());
     }
@@ -303,5 +305,13 @@ int MediaWriter::color_width() const { return impl_->color_size.width; }
 int MediaWriter::color_height() const { return impl_->color_size.height; }
 const std::vector<DepthFrameRow>& MediaWriter::depth_rows() const { return impl_->depth_rows; }
 std::uint64_t MediaWriter::size_mismatches() const { return impl_->size_mismatches; }
+
+void register_record_media(CliRegistry& registry) {
+  registry.media = [](const std::string& directory) -> std::unique_ptr<MediaSink> {
+    return std::make_unique<MediaWriter>(directory);
+  };
+  registry.quiet_logs.push_back(
+      [] { cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_ERROR); });  // our one-line messages only
+}
 
 }  // namespace pliant::cli

@@ -19,6 +19,9 @@
 // error() returns it (one line) and finish() throws it.
 // Host code: allocates. Thread safety: push_*, error() and finish() from one thread (the loop);
 // the encoder thread is internal.
+// This header has no OpenCV dependency: RecordWriter holds a MediaSink, and record_media.cpp
+// (compiled when OpenCV is found) registers MediaWriter as the CLI's media part
+// (register_record_media, called by the generated registration of cli_registry.hpp).
 #pragma once
 
 #include <cstddef>
@@ -39,36 +42,62 @@ struct DepthFrameRow {
   double fx = 0, fy = 0, cx = 0, cy = 0;
 };
 
-class MediaWriter {
+struct CliRegistry;
+
+/// The media encoder as RecordWriter uses it (the contract above).
+class MediaSink {
  public:
-  explicit MediaWriter(std::string directory, std::size_t max_queued_bytes = std::size_t{256} << 20);
-  ~MediaWriter();  ///< stops the thread; queued frames are discarded unless finish() ran
-  MediaWriter(const MediaWriter&) = delete;
-  MediaWriter& operator=(const MediaWriter&) = delete;
+  virtual ~MediaSink() = default;
+  MediaSink(const MediaSink&) = delete;
+  MediaSink& operator=(const MediaSink&) = delete;
 
   /// Queues a copy of `frame` taken at `t_s` (recording time, s). False: dropped, queue full.
-  bool push_color(const hal::ColorFrame& frame, double t_s);
-  bool push_depth(const hal::DepthFrame& frame, double t_s);
+  virtual bool push_color(const hal::ColorFrame& frame, double t_s) = 0;
+  virtual bool push_depth(const hal::DepthFrame& frame, double t_s) = 0;
 
   /// The first error of the encoder thread, empty while there is none.
-  std::string error() const;
+  virtual std::string error() const = 0;
 
   /// Writes what is queued, closes color.avi and writes color_frames.csv and depth_frames.csv
   /// (each only when frames of its kind were written). Throws std::runtime_error on the first
   /// error. Call once.
-  void finish();
+  virtual void finish() = 0;
 
   // Results, valid after finish().
-  const std::vector<double>& color_times() const;  ///< t of frame i of color.avi
-  double color_fps() const;                        ///< container rate of color.avi (0: none)
-  int color_width() const;
-  int color_height() const;
-  const std::vector<DepthFrameRow>& depth_rows() const;
-  std::uint64_t size_mismatches() const;  ///< colour frames dropped for their size
+  virtual const std::vector<double>& color_times() const = 0;  ///< t of frame i of color.avi
+  virtual double color_fps() const = 0;                        ///< container rate of color.avi (0: none)
+  virtual int color_width() const = 0;
+  virtual int color_height() const = 0;
+  virtual const std::vector<DepthFrameRow>& depth_rows() const = 0;
+  virtual std::uint64_t size_mismatches() const = 0;  ///< colour frames dropped for their size
+
+ protected:
+  MediaSink() = default;
+};
+
+/// The OpenCV encoder (record_media.cpp).
+class MediaWriter final : public MediaSink {
+ public:
+  explicit MediaWriter(std::string directory, std::size_t max_queued_bytes = std::size_t{256} << 20);
+  ~MediaWriter() override;  ///< stops the thread; queued frames are discarded unless finish() ran
+
+  bool push_color(const hal::ColorFrame& frame, double t_s) override;
+  bool push_depth(const hal::DepthFrame& frame, double t_s) override;
+  std::string error() const override;
+  void finish() override;
+  const std::vector<double>& color_times() const override;
+  double color_fps() const override;
+  int color_width() const override;
+  int color_height() const override;
+  const std::vector<DepthFrameRow>& depth_rows() const override;
+  std::uint64_t size_mismatches() const override;
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+/// Sets `registry.media` to MediaWriter, and quiets OpenCV's own log lines (record_media.cpp).
+void register_record_media(CliRegistry& registry);
 
 }  // namespace pliant::cli

@@ -66,8 +66,9 @@ OutputDirectory::OutputDirectory(const std::string& target, bool force) : force_
   if (fs::exists(status)) {
     if (!force) throw UsageError(shown_ + " exists; give --force to replace it");
     if (!replaceable(path)) {
-      throw UsageError(shown_ + " exists and is not a recording (no recording.json) nor an empty directory; "
-                                 "not replacing it, even with --force");
+      throw UsageError(shown_ +
+                       " exists and is not a recording (no recording.json) nor an empty directory; "
+                       "not replacing it, even with --force");
     }
   }
   const fs::path parent = path.has_parent_path() ? path.parent_path() : fs::path(".");

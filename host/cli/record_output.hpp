@@ -37,7 +37,7 @@ class OutputDirectory {
 
  private:
   std::string shown_;
-  std::string target_;  // absolute
+  std::string target_;   // absolute
   std::string partial_;  // absolute
   bool force_ = false;
   bool committed_ = false;

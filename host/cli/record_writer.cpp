@@ -8,10 +8,8 @@
 #include <utility>
 
 #include "atomic_write.hpp"
-
-#if PLIANT_HAVE_OPENCV
+#include "cli_registry.hpp"
 #include "record_media.hpp"
-#endif
 
 namespace pliant::cli {
 namespace {
@@ -49,11 +47,9 @@ bool admit_stamp(double t, bool& have_last, double& last, StreamCounters& counte
 RecordWriter::RecordWriter(std::string directory, double t0_s, bool media)
     : directory_(std::move(directory)), t0_s_(t0_s) {
   if (media) {
-#if PLIANT_HAVE_OPENCV
-    media_ = std::make_shared<MediaWriter>(directory_);
-#else
-    throw std::logic_error("recording frames needs OpenCV, which this build lacks");
-#endif
+    const CliRegistry& parts = cli_registry();
+    if (!parts.media) throw std::logic_error("recording frames needs OpenCV, which this build lacks");
+    media_ = parts.media(directory_);
   }
 }
 
@@ -114,12 +110,10 @@ bool RecordWriter::add_color(const hal::ColorFrame& frame) {
   }
   const double t = frame.header.stamp_s - t0_s_;
   if (!admit_stamp(t, have_color_, last_color_t_, color_counters_)) return false;
-#if PLIANT_HAVE_OPENCV
   if (!media_->push_color(frame, t)) {
     ++color_counters_.queue_full;
     return false;
   }
-#endif
   ++color_counters_.recorded;
   return true;
 }
@@ -132,79 +126,61 @@ bool RecordWriter::add_depth(const hal::DepthFrame& frame) {
   }
   const double t = frame.header.stamp_s - t0_s_;
   if (!admit_stamp(t, have_depth_, last_depth_t_, depth_counters_)) return false;
-#if PLIANT_HAVE_OPENCV
   if (!media_->push_depth(frame, t)) {
     ++depth_counters_.queue_full;
     return false;
   }
-#endif
   ++depth_counters_.recorded;
   return true;
 }
 
 std::string RecordWriter::media_error() const {
-#if PLIANT_HAVE_OPENCV
   if (media_) return media_->error();
-#endif
   return std::string();
 }
 
 void RecordWriter::finish() {
   if (finished_) throw std::logic_error("RecordWriter::finish called twice");
   finished_ = true;
-#if PLIANT_HAVE_OPENCV
   if (media_) media_->finish();
-#endif
   if (!gripper_.empty()) {
     std::ostringstream csv;
     csv << "t,width_m,target_width_m,force_n,current_a,status_bits\n";
     for (const GripperRow& r : gripper_) {
-      csv << number(r.t_s) << ',' << number(r.width_m) << ',' << number(r.target_width_m) << ','
-          << number(r.force_n) << ',' << number(r.current_a) << ',' << r.status_bits << '\n';
+      csv << number(r.t_s) << ',' << number(r.width_m) << ',' << number(r.target_width_m) << ',' << number(r.force_n)
+          << ',' << number(r.current_a) << ',' << r.status_bits << '\n';
     }
     write_file_atomically((fs::path(directory_) / kGripperState).string(), csv.str());
   }
 }
 
 const std::vector<double>& RecordWriter::color_times() const {
-#if PLIANT_HAVE_OPENCV
   if (media_) return media_->color_times();
-#endif
   return kNoTimes;
 }
 
 double RecordWriter::color_fps() const {
-#if PLIANT_HAVE_OPENCV
   if (media_) return media_->color_fps();
-#endif
   return 0;
 }
 
 int RecordWriter::color_width() const {
-#if PLIANT_HAVE_OPENCV
   if (media_) return media_->color_width();
-#endif
   return 0;
 }
 
 int RecordWriter::color_height() const {
-#if PLIANT_HAVE_OPENCV
   if (media_) return media_->color_height();
-#endif
   return 0;
 }
 
 std::size_t RecordWriter::depth_frame_count() const {
-#if PLIANT_HAVE_OPENCV
   if (media_) return media_->depth_rows().size();
-#endif
   return 0;
 }
 
 std::uint64_t RecordWriter::color_size_mismatches() const {
-#if PLIANT_HAVE_OPENCV
   if (media_) return media_->size_mismatches();
-#endif
   return 0;
 }
 

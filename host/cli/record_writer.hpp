@@ -33,8 +33,7 @@
 
 namespace pliant::cli {
 
-class MediaWriter;
-struct DepthFrameRow;
+class MediaSink;
 
 struct StreamCounters {
   std::uint64_t recorded = 0;       ///< kept (rows or frames handed to the encoder)
@@ -57,7 +56,8 @@ struct GripperRow {
 class RecordWriter {
  public:
   /// `directory` exists and is the recording being written. `media`: colour or depth frames
-  /// will come (starts the encoder thread; needs OpenCV in the build).
+  /// will come (starts the encoder thread: the media part of cli_registry(); without it, that is
+  /// without OpenCV in the build, std::logic_error: check cli_registry().media first).
   RecordWriter(std::string directory, double t0_s, bool media);
   ~RecordWriter();
   RecordWriter(const RecordWriter&) = delete;
@@ -97,9 +97,7 @@ class RecordWriter {
  private:
   std::string directory_;
   double t0_s_;
-  // shared_ptr: its deleter is bound where it is made, so builds without OpenCV (no
-  // record_media.cpp) never need MediaWriter's destructor.
-  std::shared_ptr<MediaWriter> media_;
+  std::unique_ptr<MediaSink> media_;  // null without frames
   std::vector<host::WrenchSample> wrench_;
   std::vector<GripperRow> gripper_;
   double last_color_t_ = 0, last_depth_t_ = 0;

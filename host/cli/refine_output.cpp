@@ -15,9 +15,7 @@ namespace {
 
 using host::fem::FemFrame;
 
-nlohmann::json number(double value) {
-  return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json();
-}
+nlohmann::json number(double value) { return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(); }
 
 std::string num(double value) {
   if (!std::isfinite(value)) return "?";

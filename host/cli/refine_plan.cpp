@@ -142,12 +142,9 @@ void check_estimator(const FemRecordingProblem& problem, const Traits& t, const 
 
 const char* to_string(RefineEstimator estimator) {
   switch (estimator) {
-    case RefineEstimator::force:
-      return "force";
-    case RefineEstimator::reaction:
-      return "reaction";
-    case RefineEstimator::trajectory:
-      return "trajectory";
+    case RefineEstimator::force: return "force";
+    case RefineEstimator::reaction: return "reaction";
+    case RefineEstimator::trajectory: return "trajectory";
   }
   return "?";
 }

@@ -26,9 +26,7 @@ RefineProgress::RefineProgress(bool enabled)
   if (active_) thread_ = std::thread([this] { run(); });
 }
 
-RefineProgress::~RefineProgress() {
-  finish();
-}
+RefineProgress::~RefineProgress() { finish(); }
 
 void RefineProgress::stage(const std::string& text) {
   const std::lock_guard<std::mutex> lock(mutex_);

@@ -19,12 +19,8 @@ using namespace host::fem;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-std::size_t uz(int i) {
-  return static_cast<std::size_t>(i);
-}
-Eigen::Index ix(int i) {
-  return static_cast<Eigen::Index>(i);
-}
+std::size_t uz(int i) { return static_cast<std::size_t>(i); }
+Eigen::Index ix(int i) { return static_cast<Eigen::Index>(i); }
 
 bool contains(const std::vector<int>& sorted, int value) {
   return std::binary_search(sorted.begin(), sorted.end(), value);
@@ -35,9 +31,7 @@ Eigen::VectorXd mesh_points(const host::TetMesh& mesh) {
 }
 
 // JSON number, or null for NaN and infinities (JSON has neither).
-nlohmann::json number(double value) {
-  return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json();
-}
+nlohmann::json number(double value) { return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(); }
 
 std::function<void(int, int, double)> reporter(RefineProgress& progress) {
   return [&progress](int pass, int iteration, double cost) { progress.iteration(pass, iteration, cost); };
@@ -282,15 +276,9 @@ RefineOutcome run_refine(const FemRecordingProblem& problem, const RefinePlan& p
   out.simulated_rest_m = mesh_points(problem.mesh);
   if (plan.estimator) {
     switch (*plan.estimator) {
-      case RefineEstimator::force:
-        run_force(problem, settings, progress, out);
-        break;
-      case RefineEstimator::reaction:
-        run_reaction(problem, settings, progress, out);
-        break;
-      case RefineEstimator::trajectory:
-        run_trajectory(problem, plan, settings, progress, out);
-        break;
+      case RefineEstimator::force: run_force(problem, settings, progress, out); break;
+      case RefineEstimator::reaction: run_reaction(problem, settings, progress, out); break;
+      case RefineEstimator::trajectory: run_trajectory(problem, plan, settings, progress, out); break;
     }
   }
   if (plan.rest_shape) run_rest_shape(problem, settings, progress, out);

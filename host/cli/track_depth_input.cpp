@@ -7,12 +7,10 @@
 #include <string>
 #include <utility>
 
-#include "pliant/vision/depth_list.hpp"
-
-#ifdef PLIANT_HAVE_DRIVER_OPENNI2
-#include "pliant/drivers/openni2/openni2_camera.hpp"
+#include "cli_registry.hpp"
 #include "pliant/hal/clock.hpp"
-#endif
+#include "pliant/hal/device_registry.hpp"
+#include "pliant/vision/depth_list.hpp"
 
 namespace pliant::cli {
 namespace {
@@ -45,25 +43,30 @@ class ListInput final : public DepthInput {
   int current_index_ = -1;
 };
 
-#ifdef PLIANT_HAVE_DRIVER_OPENNI2
+// The depth camera scheme that plays .oni recordings (drivers/openni2 registers it).
+constexpr const char* kOniScheme = "oni";
+
 class OniInput final : public DepthInput {
  public:
   explicit OniInput(const std::string& path) {
-    namespace oni = drivers::openni2;
     kind = "OpenNI recording";
-    hal::ManualClock clock;
-    oni::Openni2CameraConfig config;
-    config.source = oni::Openni2Source::recording;
-    config.location = path;
-    config.playback = oni::Openni2Playback::stepped;
-    oni::Openni2Camera camera(clock, config);
-    if (camera.configure() != hal::HalStatus::ok) throw vision::DepthError(path + ": " + camera.last_error());
-    if (camera.start() != hal::HalStatus::ok) throw vision::DepthError(path + ": cannot start playback: " + camera.last_error());
+    hal::ManualClock clock;  // declared before the device, which keeps a reference to it
+    hal::DeviceSpec spec;
+    spec.scheme = kOniScheme;
+    spec.location = path;
+    spec.parameters["playback"] = "stepped";
+    hal::OpenResult opened = cli_registry().devices.open(hal::DeviceCategory::depth_camera, spec, clock);
+    if (!opened) throw vision::DepthError(path + ": " + opened.error);
+    hal::OpenedDevice& device = *opened.device;
+    hal::DepthCamera& camera = *device.depth_camera();
+    if (device.start() != hal::HalStatus::ok) {
+      throw vision::DepthError(path + ": cannot start playback: " + device.last_error());
+    }
     std::size_t bytes = 0;
-    while (!camera.end_of_stream()) {
+    while (!device.ended()) {
       hal::DepthFrame frame;
       const hal::HalStatus status = camera.read(frame);
-      if (status == hal::HalStatus::no_data) continue;  // end_of_stream() decides
+      if (status == hal::HalStatus::no_data) continue;  // ended() decides
       if (status != hal::HalStatus::ok) {
         throw vision::DepthError(path + ": frame " + std::to_string(frames_.size() + 1) + ": " +
                                  hal::hal_status_name(status));
@@ -105,7 +108,6 @@ class OniInput final : public DepthInput {
   std::vector<vision::DepthImage> frames_;
   std::vector<double> times_;
 };
-#endif
 
 }  // namespace
 
@@ -119,12 +121,12 @@ bool is_oni_path(const std::string& path) {
 
 std::unique_ptr<DepthInput> open_depth_input(const std::string& path) {
   if (is_oni_path(path)) {
-#ifdef PLIANT_HAVE_DRIVER_OPENNI2
+    if (cli_registry().devices.find(hal::DeviceCategory::depth_camera, kOniScheme) == nullptr) {
+      throw vision::DepthError(path +
+                               ": .oni recordings need drivers/openni2, which this build left out "
+                               "(install libopenni2-dev and rebuild)");
+    }
     return std::make_unique<OniInput>(path);
-#else
-    throw vision::DepthError(path + ": .oni recordings need drivers/openni2, which this build left out "
-                             "(install libopenni2-dev and rebuild)");
-#endif
   }
   return std::make_unique<ListInput>(path);
 }

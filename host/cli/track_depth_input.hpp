@@ -1,6 +1,7 @@
 // The depth frames `pliant track-depth` reads: a TUM depth list, the depth_frames.csv of a
 // `pliant record` recording (both host/vision/depth_list.hpp), or an OpenNI .oni recording
-// played through drivers/openni2 (when that driver is built).
+// played through the depth camera scheme `oni` of the device registry (drivers/openni2 registers
+// it when it is built; cli_registry.hpp).
 //
 // A list's PNGs are read when asked for (one in memory at a time). An .oni file is played
 // once, stepped, at open and its frames kept in memory (at most kMaxOniBytes of depth):

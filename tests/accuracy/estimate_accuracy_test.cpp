@@ -20,8 +20,7 @@ using pliant::host::ScenarioOptions;
 // input_noise_samples: refits for the input-noise part of the uncertainty; only the tests of
 // that uncertainty need them.
 pliant::host::EstimateReport estimate(const std::string& scenario, double beta, std::uint64_t seed,
-                                      pliant::FitMode mode = pliant::FitMode::trajectory,
-                                      int input_noise_samples = 0) {
+                                      pliant::FitMode mode = pliant::FitMode::trajectory, int input_noise_samples = 0) {
   ScenarioOptions options;
   options.msm_beta = beta;
   options.noise = 0.005;
@@ -135,9 +134,11 @@ TEST(StillRest, FallsBackToFrameZero) {
   EXPECT_EQ(pliant::host::rest_from_still_frames(no_support).frames, 1);
   // Motion from the first frame on: drop the lead-in frames.
   const std::size_t per_frame = static_cast<std::size_t>(recording.particle_count * recording.dimension);
-  recording.positions.erase(recording.positions.begin(), recording.positions.begin() + static_cast<std::ptrdiff_t>(17 * per_frame));
+  recording.positions.erase(recording.positions.begin(),
+                            recording.positions.begin() + static_cast<std::ptrdiff_t>(17 * per_frame));
   recording.frame_times_s.erase(recording.frame_times_s.begin(), recording.frame_times_s.begin() + 17);
-  recording.rest_positions.assign(recording.positions.begin(), recording.positions.begin() + static_cast<std::ptrdiff_t>(per_frame));
+  recording.rest_positions.assign(recording.positions.begin(),
+                                  recording.positions.begin() + static_cast<std::ptrdiff_t>(per_frame));
   EXPECT_EQ(pliant::host::rest_from_still_frames(recording).frames, 1);
 }
 

@@ -55,7 +55,8 @@ TEST_P(BridgeAllocation, NoCallTouchesTheHeap) {
   std::vector<float> confidence(object.count(), 0.9f);
   std::vector<float> targets(object.drivable.size() * dim);
   for (std::size_t k = 0; k < object.drivable.size(); ++k) {
-    for (std::uint32_t d = 0; d < dim; ++d) targets[k * dim + d] = object.rest[static_cast<std::size_t>(object.drivable[k]) * dim + d];
+    for (std::uint32_t d = 0; d < dim; ++d)
+      targets[k * dim + d] = object.rest[static_cast<std::size_t>(object.drivable[k]) * dim + d];
   }
   std::vector<float> tracked(object.rest.size());
   std::vector<std::uint8_t> status(object.count());
@@ -92,7 +93,8 @@ TEST_P(BridgeAllocation, NoCallTouchesTheHeap) {
     AllocationCounter counter;
     double now = 0;
     for (int f = 0; f < 60; ++f) {
-      for (std::size_t i = 0; i < frame.size(); i += dim) frame[i] = object.rest[i] * (1.0f - 0.001f * static_cast<float>(f));
+      for (std::size_t i = 0; i < frame.size(); i += dim)
+        frame[i] = object.rest[i] * (1.0f - 0.001f * static_cast<float>(f));
       note(pliant_push_observations(p, now, frame.data(), confidence.data()));
       note(pliant_push_tool_contact(p, object.drivable.data(), targets.data(), f > 10 ? contacts : 0u));
       note(pliant_step_tracker(p, 1.0 / 30));
@@ -129,7 +131,9 @@ TEST_P(BridgeAllocation, NoCallTouchesTheHeap) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Dims, BridgeAllocation, ::testing::Values(2u, 3u),
-                         [](const ::testing::TestParamInfo<std::uint32_t>& dims) { return std::to_string(dims.param) + "d"; });
+                         [](const ::testing::TestParamInfo<std::uint32_t>& dims) {
+                           return std::to_string(dims.param) + "d";
+                         });
 
 }  // namespace
 }  // namespace pliant::bridge_test

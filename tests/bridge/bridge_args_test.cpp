@@ -73,7 +73,8 @@ std::vector<ConfigCase> bad_configs() {
       {"dim 4", [](pliant_config_t& c) { c.dim = 4; }, PLIANT_ERROR_INVALID_ARGUMENT},
       {"particle count 0", [](pliant_config_t& c) { c.particle_count = 0; }, PLIANT_ERROR_INVALID_ARGUMENT},
       {"particle count 1", [](pliant_config_t& c) { c.particle_count = 1; }, PLIANT_ERROR_INVALID_ARGUMENT},
-      {"particle count huge", [](pliant_config_t& c) { c.particle_count = 0xffffffffu; }, PLIANT_ERROR_INVALID_ARGUMENT},
+      {"particle count huge", [](pliant_config_t& c) { c.particle_count = 0xffffffffu; },
+       PLIANT_ERROR_INVALID_ARGUMENT},
       {"rest NULL", [](pliant_config_t& c) { c.rest_positions = nullptr; }, PLIANT_ERROR_NULL_ARGUMENT},
       {"drivable ids NULL", [](pliant_config_t& c) { c.drivable_ids = nullptr; }, PLIANT_ERROR_NULL_ARGUMENT},
       {"drivable count > N", [](pliant_config_t& c) { c.drivable_count = c.particle_count + 1; },
@@ -81,18 +82,35 @@ std::vector<ConfigCase> bad_configs() {
       {"cluster layout 3", [](pliant_config_t& c) { c.clusters.layout = 3; }, PLIANT_ERROR_INVALID_ARGUMENT},
       {"radius factor 0", [](pliant_config_t& c) { c.clusters.radius_factor = 0; }, PLIANT_ERROR_INVALID_ARGUMENT},
       {"radius factor NaN", [](pliant_config_t& c) { c.clusters.radius_factor = kNaN; }, PLIANT_ERROR_INVALID_ARGUMENT},
-      {"k 0", [](pliant_config_t& c) { c.clusters.layout = PLIANT_CLUSTERS_K_NEAREST; c.clusters.k = 0; },
+      {"k 0",
+       [](pliant_config_t& c) {
+         c.clusters.layout = PLIANT_CLUSTERS_K_NEAREST;
+         c.clusters.k = 0;
+       },
        PLIANT_ERROR_INVALID_ARGUMENT},
-      {"k 65", [](pliant_config_t& c) { c.clusters.layout = PLIANT_CLUSTERS_K_NEAREST; c.clusters.k = 65; },
+      {"k 65",
+       [](pliant_config_t& c) {
+         c.clusters.layout = PLIANT_CLUSTERS_K_NEAREST;
+         c.clusters.k = 65;
+       },
        PLIANT_ERROR_INVALID_ARGUMENT},
-      {"grid not N", [](pliant_config_t& c) {
+      {"grid not N",
+       [](pliant_config_t& c) {
          c.clusters.layout = PLIANT_CLUSTERS_GRID_BLOCKS;
-         c.clusters.grid_cols = 4; c.clusters.grid_rows = 4; c.clusters.grid_layers = 2;
-       }, PLIANT_ERROR_INVALID_ARGUMENT},
-      {"grid block larger than grid", [](pliant_config_t& c) {
+         c.clusters.grid_cols = 4;
+         c.clusters.grid_rows = 4;
+         c.clusters.grid_layers = 2;
+       },
+       PLIANT_ERROR_INVALID_ARGUMENT},
+      {"grid block larger than grid",
+       [](pliant_config_t& c) {
          c.clusters.layout = PLIANT_CLUSTERS_GRID_BLOCKS;
-         c.clusters.grid_cols = 4; c.clusters.grid_rows = 4; c.clusters.grid_layers = 3; c.clusters.block_cols = 5;
-       }, PLIANT_ERROR_INVALID_ARGUMENT},
+         c.clusters.grid_cols = 4;
+         c.clusters.grid_rows = 4;
+         c.clusters.grid_layers = 3;
+         c.clusters.block_cols = 5;
+       },
+       PLIANT_ERROR_INVALID_ARGUMENT},
       {"msm_alpha 0", [](pliant_config_t& c) { c.msm.msm_alpha = 0; }, PLIANT_ERROR_INVALID_ARGUMENT},
       {"msm_alpha 1.5", [](pliant_config_t& c) { c.msm.msm_alpha = 1.5; }, PLIANT_ERROR_INVALID_ARGUMENT},
       {"msm_alpha NaN", [](pliant_config_t& c) { c.msm.msm_alpha = kNaN; }, PLIANT_ERROR_NON_FINITE},
@@ -312,9 +330,7 @@ TEST(BridgeCalls, FailedInitLeavesNoUsableInstance) {
 
 class BridgeRefusals : public ::testing::Test {
  protected:
-  BridgeRefusals() : object_(3, 4, 4, 3) {
-    object_.drive_jaws();
-  }
+  BridgeRefusals() : object_(3, 4, 4, 3) { object_.drive_jaws(); }
   void SetUp() override {
     instance_ = std::make_unique<Instance>(object_.config());
     ASSERT_EQ(instance_->status, PLIANT_OK);
@@ -375,8 +391,8 @@ TEST_F(BridgeRefusals, PushToolContact) {
                  pliant_push_tool_contact(p_, object_.drivable.data(), target,
                                           static_cast<std::uint32_t>(object_.drivable.size()) + 1),
                  PLIANT_ERROR_INVALID_ARGUMENT, PLIANT_CALL_PUSH_TOOL_CONTACT);
-  expect_refused("not drivable", pliant_push_tool_contact(p_, &free_particle, target, 1),
-                 PLIANT_ERROR_INVALID_ARGUMENT, PLIANT_CALL_PUSH_TOOL_CONTACT);
+  expect_refused("not drivable", pliant_push_tool_contact(p_, &free_particle, target, 1), PLIANT_ERROR_INVALID_ARGUMENT,
+                 PLIANT_CALL_PUSH_TOOL_CONTACT);
   const std::int32_t out_of_range[2] = {-1, 1000};
   expect_refused("id -1", pliant_push_tool_contact(p_, &out_of_range[0], target, 1), PLIANT_ERROR_INVALID_ARGUMENT,
                  PLIANT_CALL_PUSH_TOOL_CONTACT);

@@ -74,7 +74,8 @@ TEST(BridgeDefaults, AreTheCoresDefaults) {
   EXPECT_EQ(b.gripper_fault_mask, g.gripper_fault_mask);
   EXPECT_EQ(b.wrench_fault_mask, g.wrench_fault_mask);
   EXPECT_EQ(b.camera_fault_mask, g.camera_fault_mask);
-  for (int s = 0; s < kGuardSourceCount; ++s) EXPECT_EQ(b.fault_verdict[s], static_cast<std::uint8_t>(g.fault_verdict[s]));
+  for (int s = 0; s < kGuardSourceCount; ++s)
+    EXPECT_EQ(b.fault_verdict[s], static_cast<std::uint8_t>(g.fault_verdict[s]));
   EXPECT_EQ(b.uncertain_estimate_verdict, static_cast<std::uint8_t>(g.uncertain_estimate_verdict));
   EXPECT_EQ(b.exceeded_stop_action, static_cast<std::uint8_t>(g.exceeded_stop_action));
   EXPECT_EQ(b.fault_stop_action, static_cast<std::uint8_t>(g.fault_stop_action));
@@ -163,18 +164,17 @@ TEST_P(BridgeLayout, QueriedSizeSufficesAtAnyAlignment) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    All, BridgeLayout,
-    ::testing::Values(LayoutCase{"radius_3d", 3, PLIANT_CLUSTERS_RADIUS, true, true},
-                      LayoutCase{"radius_2d", 2, PLIANT_CLUSTERS_RADIUS, true, true},
-                      LayoutCase{"k_nearest_3d", 3, PLIANT_CLUSTERS_K_NEAREST, true, true},
-                      LayoutCase{"k_nearest_2d", 2, PLIANT_CLUSTERS_K_NEAREST, true, true},
-                      LayoutCase{"grid_3d", 3, PLIANT_CLUSTERS_GRID_BLOCKS, true, true},
-                      LayoutCase{"grid_2d", 2, PLIANT_CLUSTERS_GRID_BLOCKS, true, true},
-                      LayoutCase{"tracker_only_3d", 3, PLIANT_CLUSTERS_RADIUS, false, false},
-                      LayoutCase{"no_guard_2d", 2, PLIANT_CLUSTERS_RADIUS, true, false},
-                      LayoutCase{"no_estimator_3d", 3, PLIANT_CLUSTERS_GRID_BLOCKS, false, true}),
-    layout_name);
+INSTANTIATE_TEST_SUITE_P(All, BridgeLayout,
+                         ::testing::Values(LayoutCase{"radius_3d", 3, PLIANT_CLUSTERS_RADIUS, true, true},
+                                           LayoutCase{"radius_2d", 2, PLIANT_CLUSTERS_RADIUS, true, true},
+                                           LayoutCase{"k_nearest_3d", 3, PLIANT_CLUSTERS_K_NEAREST, true, true},
+                                           LayoutCase{"k_nearest_2d", 2, PLIANT_CLUSTERS_K_NEAREST, true, true},
+                                           LayoutCase{"grid_3d", 3, PLIANT_CLUSTERS_GRID_BLOCKS, true, true},
+                                           LayoutCase{"grid_2d", 2, PLIANT_CLUSTERS_GRID_BLOCKS, true, true},
+                                           LayoutCase{"tracker_only_3d", 3, PLIANT_CLUSTERS_RADIUS, false, false},
+                                           LayoutCase{"no_guard_2d", 2, PLIANT_CLUSTERS_RADIUS, true, false},
+                                           LayoutCase{"no_estimator_3d", 3, PLIANT_CLUSTERS_GRID_BLOCKS, false, true}),
+                         layout_name);
 
 // Sizes for the docs: printed, and checked to grow with what is switched on.
 TEST(BridgeLayout, FootprintOfTheExamples) {
@@ -192,8 +192,9 @@ TEST(BridgeLayout, FootprintOfTheExamples) {
     ASSERT_EQ(pliant_workspace_size(&config, &tracker_only), PLIANT_OK);
     EXPECT_LT(tracker_only, no_estimator);
     EXPECT_LT(no_estimator, full);
-    std::printf("[footprint] %uD, %u particles, %zu-byte scalar: all %zu B, without estimator %zu B, tracker only %zu B\n",
-                dim, object.count(), sizeof(Scalar), full, no_estimator, tracker_only);
+    std::printf(
+        "[footprint] %uD, %u particles, %zu-byte scalar: all %zu B, without estimator %zu B, tracker only %zu B\n", dim,
+        object.count(), sizeof(Scalar), full, no_estimator, tracker_only);
   }
 }
 
@@ -231,7 +232,8 @@ TEST_P(BridgeLoop, SqueezeRunsThroughEveryCall) {
         }
       }
       for (std::size_t k = 0; k < object.drivable.size(); ++k) {
-        for (std::uint32_t d = 0; d < dim; ++d) targets[k * dim + d] = frame[static_cast<std::size_t>(object.drivable[k]) * dim + d];
+        for (std::uint32_t d = 0; d < dim; ++d)
+          targets[k * dim + d] = frame[static_cast<std::size_t>(object.drivable[k]) * dim + d];
       }
       ASSERT_EQ(pliant_push_observations(p, now, frame.data(), nullptr), PLIANT_OK);
       ASSERT_EQ(pliant_push_tool_contact(p, object.drivable.data(), targets.data(),
@@ -295,7 +297,9 @@ TEST_P(BridgeLoop, SqueezeRunsThroughEveryCall) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Dims, BridgeLoop, ::testing::Values(2u, 3u),
-                         [](const ::testing::TestParamInfo<std::uint32_t>& dims) { return std::to_string(dims.param) + "d"; });
+                         [](const ::testing::TestParamInfo<std::uint32_t>& dims) {
+                           return std::to_string(dims.param) + "d";
+                         });
 
 // Frames the estimator misses are counted and their time goes into the next update.
 TEST(BridgeEstimate, SkippedFramesAreCounted) {

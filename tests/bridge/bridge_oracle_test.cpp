@@ -104,11 +104,14 @@ struct CorePipeline {
              const std::vector<float>& target_xyz) {
     const int n = model.particle_count;
     for (int i = 0; i < n; ++i) {
-      for (int d = 0; d < Dim; ++d) observed[static_cast<std::size_t>(i)](d) = static_cast<Scalar>(positions[static_cast<std::size_t>(i * Dim + d)]);
+      for (int d = 0; d < Dim; ++d)
+        observed[static_cast<std::size_t>(i)](d) =
+            static_cast<Scalar>(positions[static_cast<std::size_t>(i * Dim + d)]);
     }
     targets.resize(ids.size());
     for (std::size_t k = 0; k < ids.size(); ++k) {
-      for (int d = 0; d < Dim; ++d) targets[k](d) = static_cast<Scalar>(target_xyz[k * Dim + static_cast<std::size_t>(d)]);
+      for (int d = 0; d < Dim; ++d)
+        targets[k](d) = static_cast<Scalar>(target_xyz[k * Dim + static_cast<std::size_t>(d)]);
     }
     TrackerFrame<Dim, Scalar> f;
     f.dt = static_cast<Scalar>(dt);
@@ -124,8 +127,8 @@ struct CorePipeline {
     }
     frame_stamp = stamp;
     strain_status = grasp_guard_measure_strain(guard_model, guard, strain_positions.data(), strain);
-    const Status estimated = online_deformability_update(model, estimator, static_cast<Scalar>(dt), f.driven,
-                                                         estimate_positions.data());
+    const Status estimated =
+        online_deformability_update(model, estimator, static_cast<Scalar>(dt), f.driven, estimate_positions.data());
     ASSERT_TRUE(estimated == Status::ok || estimated == Status::no_observations);
     estimate = online_deformability_estimate(estimator);
     estimate_stamp = stamp;
@@ -137,8 +140,8 @@ struct CorePipeline {
   GraspGuardOutput cycle(const pliant_guard_input_t& in) {
     GraspGuardInput g;
     g.now_s = in.now_s;
-    g.gripper = {in.gripper.stamp_s, in.gripper.width_m, in.gripper.force_n, in.gripper.current_a,
-                 in.gripper.status_bits, in.gripper.valid, in.gripper.bus_off, in.gripper.timeout};
+    g.gripper = {in.gripper.stamp_s,     in.gripper.width_m, in.gripper.force_n, in.gripper.current_a,
+                 in.gripper.status_bits, in.gripper.valid,   in.gripper.bus_off, in.gripper.timeout};
     g.wrench.stamp_s = in.wrench.stamp_s;
     for (int k = 0; k < 6; ++k) g.wrench.wrench[k] = in.wrench.wrench[k];
     g.wrench.status_bits = in.wrench.status_bits;
@@ -192,8 +195,8 @@ void expect_same_verdict(const pliant_verdict_t& b, const GraspGuardOutput& c, i
                              {b.stiffness_n_per_m, c.stiffness_n_per_m},
                              {b.slip_force_n, c.slip_force_n}};
   for (std::size_t k = 0; k < sizeof pairs / sizeof pairs[0]; ++k) {
-    EXPECT_TRUE(same(pairs[k][0], pairs[k][1])) << "cycle " << cycle << " field " << k << ": " << pairs[k][0]
-                                                << " vs " << pairs[k][1];
+    EXPECT_TRUE(same(pairs[k][0], pairs[k][1]))
+        << "cycle " << cycle << " field " << k << ": " << pairs[k][0] << " vs " << pairs[k][1];
   }
 }
 
@@ -207,13 +210,14 @@ struct Press {
   std::vector<std::vector<float>> frames;  // observed, with noise, occlusion and an outlier
   std::vector<float> tool_targets;         // [frame][Dim] the tool's observed position
 
-  Press(double beta, int frame_count, unsigned seed)
-      : object(Dim, Dim == 2 ? 8 : 4, 4, 3) {
+  Press(double beta, int frame_count, unsigned seed) : object(Dim, Dim == 2 ? 8 : 4, 4, 3) {
     const int n = static_cast<int>(object.count());
     const int down = Dim - 1;
     object.fixed.assign(static_cast<std::size_t>(n), 0);
-    for (int i = 0; i < n; ++i) object.fixed[static_cast<std::size_t>(i)] = object.rest[static_cast<std::size_t>(i * Dim + down)] == 0.0f;
-    tool = Dim == 2 ? object.id(object.nx / 2, object.ny - 1, 0) : object.id(object.nx / 2, object.ny / 2, object.nz - 1);
+    for (int i = 0; i < n; ++i)
+      object.fixed[static_cast<std::size_t>(i)] = object.rest[static_cast<std::size_t>(i * Dim + down)] == 0.0f;
+    tool =
+        Dim == 2 ? object.id(object.nx / 2, object.ny - 1, 0) : object.id(object.nx / 2, object.ny / 2, object.nz - 1);
     object.drivable = {tool};
 
     // The truth: the core model of the same object.
@@ -257,7 +261,8 @@ struct Press {
         }
       }
       if (f >= 10 && f < 50) {  // occluded long enough to be reported lost
-        for (int d = 0; d < Dim; ++d) frame[static_cast<std::size_t>(hidden * Dim + d)] = std::numeric_limits<float>::quiet_NaN();
+        for (int d = 0; d < Dim; ++d)
+          frame[static_cast<std::size_t>(hidden * Dim + d)] = std::numeric_limits<float>::quiet_NaN();
       }
       if (f == 20) frame[static_cast<std::size_t>(outlier * Dim)] += static_cast<float>(object.h);
       for (int d = 0; d < Dim; ++d) tool_targets.push_back(frame[static_cast<std::size_t>(tool * Dim + d)]);
@@ -316,7 +321,9 @@ TYPED_TEST(BridgeOracle, AgreesWithTheCoreAndFindsTheBeta) {
     for (std::uint32_t i = 0; i < n; ++i) {
       EXPECT_EQ(status[i], static_cast<std::uint8_t>(core.tracker.status[i])) << "frame " << f << " particle " << i;
       for (int d = 0; d < Dim; ++d) {
-        ASSERT_EQ(tracked[std::size_t{i} * Dim + static_cast<std::size_t>(d)], static_cast<float>(core.tracker.state.position[i](d))) << "frame " << f;
+        ASSERT_EQ(tracked[std::size_t{i} * Dim + static_cast<std::size_t>(d)],
+                  static_cast<float>(core.tracker.state.position[i](d)))
+            << "frame " << f;
       }
     }
     pliant_deformation_t deformation;
@@ -342,10 +349,19 @@ TYPED_TEST(BridgeOracle, AgreesWithTheCoreAndFindsTheBeta) {
       switch (cycle % 37) {
         case 5: in.gripper.width_m = kNaN; break;
         case 9: in.wrench.bus_off = true; break;
-        case 13: in.deformation.source = PLIANT_SOURCE_CALLER; in.deformation.stamp_s = now - 1.0;
-                 in.deformation.strain = 0.01; in.deformation.valid = true; break;
-        case 17: in.estimate.source = PLIANT_SOURCE_CALLER; in.estimate.stamp_s = now; in.estimate.msm_beta = 0.6;
-                 in.estimate.msm_beta_std = 0.02; in.estimate.valid = true; break;
+        case 13:
+          in.deformation.source = PLIANT_SOURCE_CALLER;
+          in.deformation.stamp_s = now - 1.0;
+          in.deformation.strain = 0.01;
+          in.deformation.valid = true;
+          break;
+        case 17:
+          in.estimate.source = PLIANT_SOURCE_CALLER;
+          in.estimate.stamp_s = now;
+          in.estimate.msm_beta = 0.6;
+          in.estimate.msm_beta_std = 0.02;
+          in.estimate.valid = true;
+          break;
         case 21: in.gripper.status_bits = 4; break;
         case 25: in.now_s = now - 0.5; break;
         case 29: in.deformation.timeout = true; break;
@@ -368,8 +384,8 @@ TYPED_TEST(BridgeOracle, AgreesWithTheCoreAndFindsTheBeta) {
 
   pliant_estimate_t estimate;
   ASSERT_EQ(pliant_get_estimate(bridge.pliant, &estimate), PLIANT_OK);
-  std::printf("[oracle %dD] msm_beta %.3f (truth %.2f) sd %.3f rms %.2e m, tracker prior %.3f\n", Dim, estimate.msm_beta,
-              kTruthBeta, estimate.msm_beta_std, estimate.rms, estimate.tracker_msm_beta);
+  std::printf("[oracle %dD] msm_beta %.3f (truth %.2f) sd %.3f rms %.2e m, tracker prior %.3f\n", Dim,
+              estimate.msm_beta, kTruthBeta, estimate.msm_beta_std, estimate.rms, estimate.tracker_msm_beta);
   EXPECT_NEAR(estimate.msm_beta, kTruthBeta, 0.1);
   EXPECT_TRUE(estimate.valid);
 }

@@ -102,8 +102,9 @@ TEST_P(BridgeTelemetry, EmitsWhatTheInstanceHolds) {
   pliant_tm_decoder_t decoder;
   pliant_tm_decoder_init(&decoder);
   const Decoded d = decode(buffer, n, dim, decoder);
-  const std::uint32_t chunks = (n + pliant_tm_particles_per_chunk(static_cast<std::uint8_t>(dim), PLIANT_TM_MAX_FRAME) - 1) /
-                               pliant_tm_particles_per_chunk(static_cast<std::uint8_t>(dim), PLIANT_TM_MAX_FRAME);
+  const std::uint32_t chunks =
+      (n + pliant_tm_particles_per_chunk(static_cast<std::uint8_t>(dim), PLIANT_TM_MAX_FRAME) - 1) /
+      pliant_tm_particles_per_chunk(static_cast<std::uint8_t>(dim), PLIANT_TM_MAX_FRAME);
   ASSERT_GE(chunks, 2u);
   ASSERT_EQ(d.messages.size(), 3u + chunks);
   EXPECT_EQ(d.decoder.messages, 3u + chunks);
@@ -183,7 +184,9 @@ TEST_P(BridgeTelemetry, EmitsWhatTheInstanceHolds) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Dims, BridgeTelemetry, ::testing::Values(2u, 3u),
-                         [](const ::testing::TestParamInfo<std::uint32_t>& dims) { return std::to_string(dims.param) + "d"; });
+                         [](const ::testing::TestParamInfo<std::uint32_t>& dims) {
+                           return std::to_string(dims.param) + "d";
+                         });
 
 TEST(BridgeTelemetryArgs, RefusedAndCounted) {
   LatticeObject object(3, 4, 4, 3);

@@ -85,9 +85,9 @@ TEST(cli_diagnose, FemModelNamesStiffeningOnARealCompressionCurve) {
   TempDir dir;
   const std::string recording = dir / "ef30";
   const std::string csv = std::string(PLIANT_PHANTOM_COMPRESSION_DIR) + "/source/EF30_0T_A5.csv";
-  ASSERT_EQ(run_pliant("import compression " + quoted(csv) + " -o " + quoted(recording) + " --mesh-divisions 1,8,2")
-                .status,
-            0);
+  ASSERT_EQ(
+      run_pliant("import compression " + quoted(csv) + " -o " + quoted(recording) + " --mesh-divisions 1,8,2").status,
+      0);
   const std::string report = dir / "report";
   const CommandResult r =
       run_pliant("diagnose " + quoted(recording) + " --model fem -q --json - --report " + quoted(report));

@@ -27,7 +27,8 @@ TEST(cli_estimate, UnknownKeysAreWarningsNotErrors) {
   TempDir dir;
   const fs::path recording = dir.path() / "rec";
   write_tiny_recording(recording);
-  replace_in_file(recording / "recording.json", "\"length_unit\": \"m\",", "\"length_unit\": \"m\", \"colour\": \"red\",");
+  replace_in_file(recording / "recording.json", "\"length_unit\": \"m\",",
+                  "\"length_unit\": \"m\", \"colour\": \"red\",");
   const CommandResult r = run_pliant("estimate " + quoted(recording.string()) + " --json -");
   EXPECT_EQ(r.status, 0) << r.err;
   // The estimate itself may add warnings about this tiny recording; all are warnings.

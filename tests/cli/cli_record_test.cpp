@@ -136,9 +136,7 @@ class CliRecordTest : public ::testing::Test {
     if (motion_.joinable()) motion_.join();
   }
 
-  std::string modbus(const std::string& kind) const {
-    return kind + ":127.0.0.1:" + std::to_string(port_);
-  }
+  std::string modbus(const std::string& kind) const { return kind + ":127.0.0.1:" + std::to_string(port_); }
 
   std::unique_ptr<modbus::ModbusEmulator> emulator_;
   int port_ = 0;
@@ -219,8 +217,8 @@ TEST_F(CliRecordTest, GripperForceAndVideoOnOneClock) {
   }
   const auto gripper_state = csv_rows(fs::path(rec) / "gripper_state.csv");
   ASSERT_EQ(gripper_state.size(), static_cast<std::size_t>(frames) + 1);
-  EXPECT_EQ(gripper_state[0], (std::vector<std::string>{"t", "width_m", "target_width_m", "force_n", "current_a",
-                                                          "status_bits"}));
+  EXPECT_EQ(gripper_state[0],
+            (std::vector<std::string>{"t", "width_m", "target_width_m", "force_n", "current_a", "status_bits"}));
   EXPECT_EQ(gripper_state[1][3], "nan");  // force not sensed
   EXPECT_DOUBLE_EQ(std::stod(gripper_state[1][0]), recording.frame_times_s[0]);
   // Colour frames: a file plays in real time from the start, so frame k is due k/20 s after the
@@ -302,9 +300,8 @@ TEST_F(CliRecordTest, FileNameInAnotherEncoding) {
   const std::string video = dir / "caf\xe9.avi";  // Latin-1: not valid UTF-8
   write_video(video, 4, 20.0);
   const std::string rec = dir / "rec";
-  const CommandResult r =
-      run_pliant("record --gripper " + modbus("robotiq-tcp") + " --color " + quoted("video:" + video) + " -q -o " +
-                 quoted(rec));
+  const CommandResult r = run_pliant("record --gripper " + modbus("robotiq-tcp") + " --color " +
+                                     quoted("video:" + video) + " -q -o " + quoted(rec));
   ASSERT_EQ(r.status, 0) << r.err;
   const host::Recording recording = host::read_recording(rec);
   const std::string spec = recording.meta["devices"]["color"]["spec"].get<std::string>();
@@ -315,15 +312,15 @@ TEST_F(CliRecordTest, MalformedSpecsWriteNothing) {
   TempDir dir;
   const std::string rec = dir / "rec";
   const std::vector<std::string> bad = {
-      "--gripper robotiq-tcp:localhost:502",         // no name lookup
+      "--gripper robotiq-tcp:localhost:502",          // no name lookup
       "--gripper " + modbus("robotiq-tcp") + "@300",  // slave out of range
       "--ft ati-can:can0 --gripper " + modbus("robotiq-tcp"),
       "--color webcam:0 --roi 0,0,10,10",
       "--depth openni2:any --gripper robotiq-rtu:",
-      "--gripper " + modbus("ft300-tcp"),             // a --ft kind
-      "--ft " + modbus("ft300-tcp"),                  // no source of particles
-      "--color video:x.avi",                          // no source of particles either
-      "--gripper " + modbus("robotiq-tcp") + " --grid 3x3",  // tracking option without a region
+      "--gripper " + modbus("ft300-tcp"),                       // a --ft kind
+      "--ft " + modbus("ft300-tcp"),                            // no source of particles
+      "--color video:x.avi",                                    // no source of particles either
+      "--gripper " + modbus("robotiq-tcp") + " --grid 3x3",     // tracking option without a region
       "--gripper " + modbus("robotiq-tcp") + " --roi 1,2,3,4",  // a region without a colour source
       "--color video:x.avi --roi 1,2,3",
       "--color video:x.avi --roi 0,0,50,50 --flow lucas",
@@ -432,9 +429,8 @@ TEST_F(CliRecordTest, ParticlesTrackedInTheRecordedVideo) {
   const std::string video = dir / "press.avi";
   write_video(video, 12, 20.0);
   const std::string rec = dir / "rec";
-  const CommandResult r =
-      run_pliant("record --color " + quoted("video:" + video) + " --ft " + modbus("ft300-tcp") +
-                 " --roi 40,20,80,70 --grid 3x4 --support bottom --driven 1 -q -o " + quoted(rec));
+  const CommandResult r = run_pliant("record --color " + quoted("video:" + video) + " --ft " + modbus("ft300-tcp") +
+                                     " --roi 40,20,80,70 --grid 3x4 --support bottom --driven 1 -q -o " + quoted(rec));
   ASSERT_EQ(r.status, 0) << r.err;
   const host::Recording recording = host::read_recording(rec);
   EXPECT_EQ(recording.length_unit, "px");
@@ -456,7 +452,7 @@ TEST_F(CliRecordTest, ParticlesTrackedInTheRecordedVideo) {
   const int last = recording.frame_count() - 1;
   const double driven_motion = recording.position(last, 1, 1) - recording.position(0, 1, 1);
   const double support_motion = recording.position(last, 9, 1) - recording.position(0, 9, 1);
-  EXPECT_GT(driven_motion, 4.0);  // about 7.5 px
+  EXPECT_GT(driven_motion, 4.0);                           // about 7.5 px
   EXPECT_LT(std::abs(support_motion), driven_motion / 2);  // about 2.4 px
   // A region outside the frames is refused at the first frame, and nothing is kept.
   const std::string rec2 = dir / "rec2";

@@ -91,11 +91,11 @@ TEST(RecordWriter, SamplesOnTheRecordingClockAndDrops) {
   TempDir dir;
   RecordWriter w(dir.path().string(), 100.0, false);
   EXPECT_TRUE(w.add_wrench(wrench(100.25, 1.0)));
-  EXPECT_FALSE(w.add_wrench(wrench(kNaN, 1.0)));                    // stamp
-  EXPECT_FALSE(w.add_wrench(wrench(100.5, kNaN)));                  // value
-  EXPECT_FALSE(w.add_wrench(wrench(100.25, 1.0)));                  // same stamp
-  EXPECT_FALSE(w.add_wrench(wrench(100.125, 1.0)));                 // earlier
-  EXPECT_FALSE(w.add_wrench(wrench(100.5, 1.0, hal::kFtAdcHigh)));  // the sensor says "do not trust"
+  EXPECT_FALSE(w.add_wrench(wrench(kNaN, 1.0)));                        // stamp
+  EXPECT_FALSE(w.add_wrench(wrench(100.5, kNaN)));                      // value
+  EXPECT_FALSE(w.add_wrench(wrench(100.25, 1.0)));                      // same stamp
+  EXPECT_FALSE(w.add_wrench(wrench(100.125, 1.0)));                     // earlier
+  EXPECT_FALSE(w.add_wrench(wrench(100.5, 1.0, hal::kFtAdcHigh)));      // the sensor says "do not trust"
   EXPECT_TRUE(w.add_wrench(wrench(100.5, -4.0, hal::kFtCanBusError)));  // degraded transport only: kept
   ASSERT_EQ(w.wrench().size(), 2u);
   EXPECT_DOUBLE_EQ(w.wrench()[0].t_s, 0.25);
@@ -148,7 +148,7 @@ TEST(RecordWriter, ColourVideoAndFrameTimes) {
   // another size in between.
   for (int k = 0; k < 12; ++k) {
     const double stamp = 10.0 + 0.04 * k;
-    const hal::PixelFormat format = k % 3 == 0 ? hal::PixelFormat::rgb8
+    const hal::PixelFormat format = k % 3 == 0   ? hal::PixelFormat::rgb8
                                     : k % 3 == 1 ? hal::PixelFormat::bgr8
                                                  : hal::PixelFormat::mono8;
     const std::uint8_t* colour = k % 3 == 0 ? red_rgb : k % 3 == 1 ? red_bgr : grey;
@@ -209,7 +209,8 @@ TEST(RecordWriter, DepthImagesAreLossless) {
   const int width = 20, height = 10, stride_px = 23;
   std::vector<std::uint16_t> pixels(static_cast<std::size_t>(stride_px * height), 0xbeef);
   for (int y = 0; y < height; ++y) {
-    for (int x = 0; x < width; ++x) pixels[static_cast<std::size_t>(y * stride_px + x)] = static_cast<std::uint16_t>(1000 * y + x);
+    for (int x = 0; x < width; ++x)
+      pixels[static_cast<std::size_t>(y * stride_px + x)] = static_cast<std::uint16_t>(1000 * y + x);
   }
   hal::DepthFrame frame;
   frame.width = width;

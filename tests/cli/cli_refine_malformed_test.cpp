@@ -12,9 +12,7 @@ namespace {
 
 const std::string kPhantom = std::string(PLIANT_PHANTOM_COMPRESSION_DIR) + "/EF30_0T_A5";
 
-bool contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 // Exit 2, one line under the command's prefix containing `reason`, nothing on stdout.
 void expect_refused(const CommandResult& r, const std::string& reason) {

@@ -21,17 +21,11 @@ namespace {
 
 const std::string kPhantoms = PLIANT_PHANTOM_COMPRESSION_DIR;
 
-bool contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
-nlohmann::json read_json(const fs::path& path) {
-  return nlohmann::json::parse(read_text(path));
-}
+nlohmann::json read_json(const fs::path& path) { return nlohmann::json::parse(read_text(path)); }
 
-double relative_error(double value, double truth) {
-  return std::abs(value - truth) / std::abs(truth);
-}
+double relative_error(double value, double truth) { return std::abs(value - truth) / std::abs(truth); }
 
 int count_files(const fs::path& directory, const std::string& extension) {
   int count = 0;
@@ -170,8 +164,9 @@ TEST(cli_refine, VibratingBarFitsModulusAndDampingWithTheTrajectoryEstimator) {
       run_pliant("refine " + quoted(recording.string()) + " -q --json " + quoted(card_path) + " --vtk " + quoted(vtk));
   ASSERT_EQ(r.status, 0) << r.err;
   // The summary names the estimator and why, and every parameter with its source.
-  const std::vector<std::string> expected = {"trajectory: no wrench", "rayleigh_alpha", "rayleigh_beta",
-                                             "poisson_ratio", "(given)", "wrote " + card_path, "refine.pvd"};
+  const std::vector<std::string> expected = {
+      "trajectory: no wrench", "rayleigh_alpha", "rayleigh_beta", "poisson_ratio", "(given)",
+      "wrote " + card_path,    "refine.pvd"};
   for (const std::string& text : expected) EXPECT_TRUE(contains(r.out, text)) << text << " in\n" << r.out;
   const nlohmann::json card = read_json(card_path);
   expect_card_follows_spec(card, read_json(recording / "recording.json"));

@@ -49,9 +49,8 @@ TEST(CliReplay, ScriptedFaultsReachTheDevicesAndAreCounted) {
              "1.0 disconnect observer 0.2\n"
              "2.0 occlude observer 0.5 0.5\n"
              "3.0 stamp_jump observer 0.04 -1\n");
-  const CommandResult r =
-      run_pliant("replay --stepped " + quoted(kFoamMedium) + " --faults " + quoted(dir / "faults.txt") + " -o " +
-                 quoted(dir / "out.jsonl"));
+  const CommandResult r = run_pliant("replay --stepped " + quoted(kFoamMedium) + " --faults " +
+                                     quoted(dir / "faults.txt") + " -o " + quoted(dir / "out.jsonl"));
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(r.out.empty());
   const std::string out = read_text(dir / "out.jsonl");
@@ -79,7 +78,8 @@ TEST(CliReplay, WrenchAndGripperAreReplayedBesideTheParticles) {
   replace_in_file(rec / "recording.json", R"("particles": "particles.csv" })",
                   R"("particles": "particles.csv", "wrench": "wrench.csv", "gripper": "gripper.csv" },
   "wrench": { "applied_to": [2, 3] })");
-  write_text(rec / "wrench.csv", "t,fx,fy,fz,tx,ty,tz\n0,0,0,0,0,0,0\n0.05,0,-1,0,0,0,0\n0.1,0,-2,0,0,0,0\n0.15,0,-3,0,0,0,0\n");
+  write_text(rec / "wrench.csv",
+             "t,fx,fy,fz,tx,ty,tz\n0,0,0,0,0,0,0\n0.05,0,-1,0,0,0,0\n0.1,0,-2,0,0,0,0\n0.15,0,-3,0,0,0,0\n");
   write_text(rec / "gripper.csv", "t,width,force\n0,1,0\n0.1,0.9,2\n0.2,0.85,3\n");
   const CommandResult r = run_pliant("replay --stepped --no-estimate " + quoted(rec.string()));
   ASSERT_EQ(r.status, 0) << r.err;

@@ -65,10 +65,14 @@ struct BadValue {
 
 TEST(cli_simulate, BadValuesExitTwoWithOneLineAndWriteNothing) {
   const std::vector<BadValue> cases = {
-      {"foam_press --beta 1.5", "--beta"},   {"foam_press --beta -0.1", "--beta"},
-      {"foam_press --alpha 0", "--alpha"},   {"foam_press --noise -1", "--noise"},
-      {"foam_press --rate 0", "--rate"},     {"foam_press --rate 1e9", "--rate"},
-      {"foam_press --seed -3", "--seed"},    {"foam_press --beta soft", "--beta"},
+      {"foam_press --beta 1.5", "--beta"},
+      {"foam_press --beta -0.1", "--beta"},
+      {"foam_press --alpha 0", "--alpha"},
+      {"foam_press --noise -1", "--noise"},
+      {"foam_press --rate 0", "--rate"},
+      {"foam_press --rate 1e9", "--rate"},
+      {"foam_press --seed -3", "--seed"},
+      {"foam_press --beta soft", "--beta"},
       {"jelly_wobble", "jelly_wobble"},
       {"foam_press --effect plastic", "plasticity, viscosity, friction, gravity, heterogeneity, stiffening"},
       {"foam_press --effect plasticity:foo=1", "yield, creep, max"},
@@ -77,10 +81,13 @@ TEST(cli_simulate, BadValuesExitTwoWithOneLineAndWriteNothing) {
       {"foam_press --effect gravity:g=-2", "g must be >= 0"},
       {"foam_press --effect viscosity:tau=0", "tau"},
       {"foam_press --effect ''", "--effect"},
-      {"foam_press --substeps 0", "--substeps"},  {"foam_press --substeps 100", "--substeps"},
+      {"foam_press --substeps 0", "--substeps"},
+      {"foam_press --substeps 100", "--substeps"},
       {"foam_press --cluster-radius 0.5", "--cluster-radius"},
-      {"foam_press --occlusion 0.8", "--occlusion"}, {"foam_press --occlusion -0.1", "--occlusion"},
-      {"foam_press --depth 0", "--depth"},       {"foam_press --depth 3", "--depth"},
+      {"foam_press --occlusion 0.8", "--occlusion"},
+      {"foam_press --occlusion -0.1", "--occlusion"},
+      {"foam_press --depth 0", "--depth"},
+      {"foam_press --depth 3", "--depth"},
   };
   for (const BadValue& c : cases) {
     TempDir dir;
@@ -124,8 +131,8 @@ TEST(cli_simulate, ConcealedEffectLeavesNoTraceInTheRecording) {
 }
 
 TEST(cli_simulate, NewScenariosAndReleaseWriteDrivenWindowsThatEnd) {
-  for (const std::string arguments : {"ring_squeeze", "dome_press", "foam_press --release --depth 0.1",
-                                      "block_press --release"}) {
+  for (const std::string arguments :
+       {"ring_squeeze", "dome_press", "foam_press --release --depth 0.1", "block_press --release"}) {
     TempDir dir;
     const std::string out = dir / "rec";
     const CommandResult r = run_pliant("simulate " + arguments + " -o " + quoted(out));

@@ -64,8 +64,8 @@ inline CommandResult run_pliant(const std::string& arguments) {
   TempDir capture;
   const std::string out_path = capture / "stdout";
   const std::string err_path = capture / "stderr";
-  const std::string command = quoted(PLIANT_EXE) + " " + arguments + " </dev/null >" + quoted(out_path) +
-                              " 2>" + quoted(err_path);
+  const std::string command =
+      quoted(PLIANT_EXE) + " " + arguments + " </dev/null >" + quoted(out_path) + " 2>" + quoted(err_path);
   const int raw = std::system(command.c_str());
   CommandResult result;
   result.status = raw != -1 && WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;

@@ -77,9 +77,12 @@ TEST(cli_usage, BadEstimateOptionValuesExitTwoWithOneLine) {
   TempDir dir;
   write_tiny_recording(dir / "rec");
   const std::vector<BadOption> cases = {
-      {"--mode sideways", "--mode"},       {"--grid 2", "--grid"},
-      {"--grid many", "--grid"},           {"--msm-alpha 0", "--msm-alpha"},
-      {"--msm-alpha 1.5", "--msm-alpha"},  {"--alpha --mode final", "--alpha"},
+      {"--mode sideways", "--mode"},
+      {"--grid 2", "--grid"},
+      {"--grid many", "--grid"},
+      {"--msm-alpha 0", "--msm-alpha"},
+      {"--msm-alpha 1.5", "--msm-alpha"},
+      {"--alpha --mode final", "--alpha"},
       {"--alpha --msm-alpha 0.5", "--alpha"},
   };
   for (const BadOption& c : cases) {

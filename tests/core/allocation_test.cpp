@@ -421,7 +421,8 @@ TYPED_TEST(RealTimeAllocation, MsmStepWithAllFeatures) {
 
   std::vector<Scalar> cluster_beta(static_cast<std::size_t>(scene.model.cluster_count));
   for (std::size_t c = 0; c < cluster_beta.size(); ++c) {
-    cluster_beta[c] = static_cast<Scalar>(0.1 + 0.8 * static_cast<double>(c) / static_cast<double>(cluster_beta.size()));
+    cluster_beta[c] =
+        static_cast<Scalar>(0.1 + 0.8 * static_cast<double>(c) / static_cast<double>(cluster_beta.size()));
   }
   MsmParams<Dim, Scalar> params;
   params.msm_alpha = Scalar(0.9);
@@ -628,7 +629,8 @@ TYPED_TEST(RealTimeAllocation, OnlineDeformability) {
     driven.positions = &scene.tool_targets[static_cast<std::size_t>(k)];
     ASSERT_EQ(online_deformability_update(scene.model, estimator, dt, driven, scene.frame(k)), Status::ok);
   }
-  std::vector<Vec> unobserved(static_cast<std::size_t>(scene.n), Vec::Constant(std::numeric_limits<Scalar>::quiet_NaN()));
+  std::vector<Vec> unobserved(static_cast<std::size_t>(scene.n),
+                              Vec::Constant(std::numeric_limits<Scalar>::quiet_NaN()));
   std::vector<Status> statuses(Scene<Dim, Scalar>::kFrames, Status::not_initialized);
   OnlineDeformabilityEstimate estimate;
   Status empty = Status::ok, rejected = Status::ok;
@@ -639,7 +641,8 @@ TYPED_TEST(RealTimeAllocation, OnlineDeformability) {
     online_deformability_reset(scene.model, estimator);
     for (int k = 1; k < Scene<Dim, Scalar>::kFrames; ++k) {
       driven.positions = &scene.tool_targets[static_cast<std::size_t>(k)];
-      statuses[static_cast<std::size_t>(k)] = online_deformability_update(scene.model, estimator, dt, driven, scene.frame(k));
+      statuses[static_cast<std::size_t>(k)] =
+          online_deformability_update(scene.model, estimator, dt, driven, scene.frame(k));
     }
     estimate = online_deformability_estimate(estimator);
     empty = online_deformability_update(scene.model, estimator, dt, driven, unobserved.data());
@@ -648,7 +651,8 @@ TYPED_TEST(RealTimeAllocation, OnlineDeformability) {
     counts = counter.stop();
   }
   EXPECT_NO_HEAP(counts, "online_deformability reset/update/estimate");
-  for (int k = 1; k < Scene<Dim, Scalar>::kFrames; ++k) EXPECT_EQ(statuses[static_cast<std::size_t>(k)], Status::ok) << k;
+  for (int k = 1; k < Scene<Dim, Scalar>::kFrames; ++k)
+    EXPECT_EQ(statuses[static_cast<std::size_t>(k)], Status::ok) << k;
   EXPECT_EQ(empty, Status::no_observations);
   EXPECT_EQ(rejected, Status::invalid_argument);
   EXPECT_EQ(estimate.frames, static_cast<std::uint32_t>(Scene<Dim, Scalar>::kFrames - 1));
@@ -809,10 +813,13 @@ TYPED_TEST(RealTimeAllocation, EvaluateDeformabilityError) {
   AllocationCounts counts;
   {
     AllocationCounter counter;
-    s_truth = evaluate_deformability_error(scene.model, truth, scene.observations, trajectory, owned.workspace, at_truth);
-    s_wrong = evaluate_deformability_error(scene.model, wrong, scene.observations, trajectory, owned.workspace, at_wrong);
+    s_truth =
+        evaluate_deformability_error(scene.model, truth, scene.observations, trajectory, owned.workspace, at_truth);
+    s_wrong =
+        evaluate_deformability_error(scene.model, wrong, scene.observations, trajectory, owned.workspace, at_wrong);
     msm_state_reset(scene.model, owned.workspace.state);
-    s_final = evaluate_deformability_error(scene.model, truth, scene.observations, final_mode, owned.workspace, at_final);
+    s_final =
+        evaluate_deformability_error(scene.model, truth, scene.observations, final_mode, owned.workspace, at_final);
     counts = counter.stop();
   }
   EXPECT_NO_HEAP(counts, "evaluate_deformability_error");

@@ -28,7 +28,8 @@ struct Estimation {
     pliant::Arena arena(block.data(), block.size());
     EXPECT_EQ(pliant::deformability_workspace_init(arena, fixture.model, 1, config, workspace), Status::ok);
     const auto obs = override_obs != nullptr ? *override_obs : experiment.observations();
-    status = pliant::estimate_deformability(fixture.model, pliant::MsmParams<Dim, Scalar>{}, obs, config, workspace, result);
+    status =
+        pliant::estimate_deformability(fixture.model, pliant::MsmParams<Dim, Scalar>{}, obs, config, workspace, result);
   }
 };
 

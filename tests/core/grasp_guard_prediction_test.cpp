@@ -141,7 +141,8 @@ struct ReferenceSqueeze {
         double move = 0;
         for (int i = 0; i < n; ++i) {
           state.velocity[i].setZero();
-          move = std::max(move, static_cast<double>((state.position[i] - previous[static_cast<std::size_t>(i)]).norm()));
+          move =
+              std::max(move, static_cast<double>((state.position[i] - previous[static_cast<std::size_t>(i)]).norm()));
         }
         settled = move <= tolerance;
       }
@@ -340,7 +341,8 @@ TYPED_TEST(GraspGuardPrediction, SafeClosureIsConservativeAgainstDirectSimulatio
   for (int j : {0, 2, 5, 8}) {
     const double beta = static_cast<double>(j) / (guard.beta_points - 1);
     ReferenceSqueeze<Dim, Scalar> reference(object.model, beta);
-    const double crossing = reference.first_crossing(step, guard.closure_points * guard.closure_step_m, config.max_strain);
+    const double crossing =
+        reference.first_crossing(step, guard.closure_points * guard.closure_step_m, config.max_strain);
     ASSERT_TRUE(std::isfinite(crossing)) << beta;
     EXPECT_LE(guard.crossing_closure_m[j], crossing) << "beta " << beta;
     EXPECT_GE(guard.crossing_closure_m[j], crossing - resolution - step - 1e-12) << "beta " << beta;
@@ -350,22 +352,24 @@ TYPED_TEST(GraspGuardPrediction, SafeClosureIsConservativeAgainstDirectSimulatio
   };
   // The last trial puts the truth at the low-beta end of a wide interval, where the strain is
   // highest: only the worst case over the interval is conservative there.
-  for (const Trial& trial : {Trial{0.37, 0.40, 0.03}, Trial{0.83, 0.80, 0.05}, Trial{0.12, 0.10, 0.02},
-                             Trial{0.02, 0.25, 0.12}}) {
+  for (const Trial& trial :
+       {Trial{0.37, 0.40, 0.03}, Trial{0.83, 0.80, 0.05}, Trial{0.12, 0.10, 0.02}, Trial{0.02, 0.25, 0.12}}) {
     SCOPED_TRACE("true beta " + std::to_string(trial.truth));
     ReferenceSqueeze<Dim, Scalar> reference(object.model, trial.truth);
-    const double crossing = reference.first_crossing(step, guard.closure_points * guard.closure_step_m, config.max_strain);
+    const double crossing =
+        reference.first_crossing(step, guard.closure_points * guard.closure_step_m, config.max_strain);
     ASSERT_TRUE(std::isfinite(crossing));
     EXPECT_TRUE(reference.converged);
     const double k = config.confidence_k;
-    const double safe = grasp_guard_strain_safe_closure(guard, trial.estimate - k * trial.sd, trial.estimate + k * trial.sd);
+    const double safe =
+        grasp_guard_strain_safe_closure(guard, trial.estimate - k * trial.sd, trial.estimate + k * trial.sd);
     EXPECT_LE(safe, crossing) << "the predicted safe closure is past the true crossing";
     EXPECT_GE(safe, (trial.sd > 0.1 ? 0.7 : 0.85) * crossing) << "the prediction is uselessly conservative";
     // Strain at about half the crossing: the prediction bounds the reference from above.
     const std::size_t half = reference.strains.size() / 2;
     const double closure = static_cast<double>(half + 1) * step;
-    const double predicted = grasp_guard_predicted_strain(guard, closure, trial.estimate - k * trial.sd,
-                                                          trial.estimate + k * trial.sd);
+    const double predicted =
+        grasp_guard_predicted_strain(guard, closure, trial.estimate - k * trial.sd, trial.estimate + k * trial.sd);
     EXPECT_GE(predicted, reference.strains[half] * (1 - 1e-3));
     EXPECT_LE(predicted, reference.strains[half] * 1.35);
     // The gauge on the reference's last state against the SVD.

@@ -29,7 +29,8 @@ bool has(const GraspGuardOutput& out, GuardReason reason) {
 std::string describe(const GraspGuardOutput& out) {
   std::string text = std::string(grasp_verdict_name(out.verdict)) + "/" + guard_reason_name(out.reason) + " [";
   for (int r = 1; r < kGuardReasonCount; ++r) {
-    if ((out.reasons & (1u << static_cast<unsigned>(r))) != 0) text += std::string(guard_reason_name(static_cast<GuardReason>(r))) + " ";
+    if ((out.reasons & (1u << static_cast<unsigned>(r))) != 0)
+      text += std::string(guard_reason_name(static_cast<GuardReason>(r))) + " ";
   }
   return text + "]";
 }
@@ -162,62 +163,74 @@ std::vector<Fault> faults() {
   auto restore_width = [](Rig& r) { r.squeeze(r.closure); };
   auto restore_wrench = [](Rig& r) { r.in.wrench.wrench[2] = -3.0; };
   return {
-      {"nan width", [](Rig& r) { r.in.gripper.width_m = kNaN; }, restore_width, GuardReason::nan_input, GuardSource::gripper},
-      {"inf force", [](Rig& r) { r.in.gripper.force_n = kInf; }, restore_width, GuardReason::nan_input, GuardSource::gripper},
-      {"nan gripper stamp", [](Rig& r) { r.hold(GuardSource::gripper); r.in.gripper.stamp_s = kNaN; },
+      {"nan width", [](Rig& r) { r.in.gripper.width_m = kNaN; }, restore_width, GuardReason::nan_input,
+       GuardSource::gripper},
+      {"inf force", [](Rig& r) { r.in.gripper.force_n = kInf; }, restore_width, GuardReason::nan_input,
+       GuardSource::gripper},
+      {"nan gripper stamp",
+       [](Rig& r) {
+         r.hold(GuardSource::gripper);
+         r.in.gripper.stamp_s = kNaN;
+       },
        [](Rig& r) { r.resume(GuardSource::gripper); }, GuardReason::nan_input, GuardSource::gripper},
-      {"nan wrench Fz", [](Rig& r) { r.in.wrench.wrench[2] = kNaN; }, restore_wrench, GuardReason::nan_input, GuardSource::wrench},
+      {"nan wrench Fz", [](Rig& r) { r.in.wrench.wrench[2] = kNaN; }, restore_wrench, GuardReason::nan_input,
+       GuardSource::wrench},
       {"nan torque", [](Rig& r) { r.in.wrench.wrench[4] = kNaN; }, [](Rig& r) { r.in.wrench.wrench[4] = 0.02; },
        GuardReason::nan_input, GuardSource::wrench},
       {"nan strain", [](Rig& r) { r.in.deformation.strain = kNaN; }, [](Rig& r) { r.in.deformation.strain = 0.01; },
        GuardReason::nan_input, GuardSource::camera},
       {"nan beta", [](Rig& r) { r.in.estimate.msm_beta = kNaN; }, [](Rig& r) { r.in.estimate.msm_beta = 0.4; },
        GuardReason::nan_input, GuardSource::estimate},
-      {"nan beta sd", [](Rig& r) { r.in.estimate.msm_beta_std = kNaN; }, [](Rig& r) { r.in.estimate.msm_beta_std = 0.02; },
-       GuardReason::nan_input, GuardSource::estimate},
+      {"nan beta sd", [](Rig& r) { r.in.estimate.msm_beta_std = kNaN; },
+       [](Rig& r) { r.in.estimate.msm_beta_std = 0.02; }, GuardReason::nan_input, GuardSource::estimate},
       {"gripper invalid", [](Rig& r) { r.in.gripper.valid = false; }, [](Rig& r) { r.in.gripper.valid = true; },
        GuardReason::invalid_input, GuardSource::gripper},
       {"negative width", [](Rig& r) { r.in.gripper.width_m = -0.001; }, restore_width, GuardReason::invalid_input,
        GuardSource::gripper},
-      {"width in mm", [](Rig& r) { r.in.gripper.width_m = 40.0; }, restore_width, GuardReason::invalid_input, GuardSource::gripper},
-      {"future gripper stamp", [](Rig& r) { r.hold(GuardSource::gripper); r.in.gripper.stamp_s = r.t + 1.0; },
+      {"width in mm", [](Rig& r) { r.in.gripper.width_m = 40.0; }, restore_width, GuardReason::invalid_input,
+       GuardSource::gripper},
+      {"future gripper stamp",
+       [](Rig& r) {
+         r.hold(GuardSource::gripper);
+         r.in.gripper.stamp_s = r.t + 1.0;
+       },
        [](Rig& r) { r.resume(GuardSource::gripper); }, GuardReason::invalid_input, GuardSource::gripper},
       {"wrench invalid", [](Rig& r) { r.in.wrench.valid = false; }, [](Rig& r) { r.in.wrench.valid = true; },
        GuardReason::invalid_input, GuardSource::wrench},
-      {"negative strain", [](Rig& r) { r.in.deformation.strain = -0.2; }, [](Rig& r) { r.in.deformation.strain = 0.01; },
-       GuardReason::invalid_input, GuardSource::camera},
+      {"negative strain", [](Rig& r) { r.in.deformation.strain = -0.2; },
+       [](Rig& r) { r.in.deformation.strain = 0.01; }, GuardReason::invalid_input, GuardSource::camera},
       {"beta above 1", [](Rig& r) { r.in.estimate.msm_beta = 1.2; }, [](Rig& r) { r.in.estimate.msm_beta = 0.4; },
        GuardReason::invalid_input, GuardSource::estimate},
       {"estimate invalid", [](Rig& r) { r.in.estimate.valid = false; }, [](Rig& r) { r.in.estimate.valid = true; },
        GuardReason::invalid_input, GuardSource::estimate},
-      {"gripper fault bits", [](Rig& r) { r.in.gripper.status_bits = 0x0e; }, [](Rig& r) { r.in.gripper.status_bits = 0; },
-       GuardReason::sensor_fault, GuardSource::gripper},
+      {"gripper fault bits", [](Rig& r) { r.in.gripper.status_bits = 0x0e; },
+       [](Rig& r) { r.in.gripper.status_bits = 0; }, GuardReason::sensor_fault, GuardSource::gripper},
       {"ATI supply low", [](Rig& r) { r.in.wrench.status_bits = 1u << 5; }, [](Rig& r) { r.in.wrench.status_bits = 0; },
        GuardReason::sensor_fault, GuardSource::wrench},
-      {"camera status", [](Rig& r) { r.in.deformation.status_bits = 1; }, [](Rig& r) { r.in.deformation.status_bits = 0; },
-       GuardReason::sensor_fault, GuardSource::camera},
+      {"camera status", [](Rig& r) { r.in.deformation.status_bits = 1; },
+       [](Rig& r) { r.in.deformation.status_bits = 0; }, GuardReason::sensor_fault, GuardSource::camera},
       {"gripper bus off", [](Rig& r) { r.in.gripper.bus_off = true; }, [](Rig& r) { r.in.gripper.bus_off = false; },
        GuardReason::bus_off, GuardSource::gripper},
       {"F/T bus off", [](Rig& r) { r.in.wrench.bus_off = true; }, [](Rig& r) { r.in.wrench.bus_off = false; },
        GuardReason::bus_off, GuardSource::wrench},
-      {"camera bus off", [](Rig& r) { r.in.deformation.bus_off = true; }, [](Rig& r) { r.in.deformation.bus_off = false; },
-       GuardReason::bus_off, GuardSource::camera},
+      {"camera bus off", [](Rig& r) { r.in.deformation.bus_off = true; },
+       [](Rig& r) { r.in.deformation.bus_off = false; }, GuardReason::bus_off, GuardSource::camera},
       {"Modbus timeout", [](Rig& r) { r.in.gripper.timeout = true; }, [](Rig& r) { r.in.gripper.timeout = false; },
        GuardReason::timeout, GuardSource::gripper},
       {"F/T timeout", [](Rig& r) { r.in.wrench.timeout = true; }, [](Rig& r) { r.in.wrench.timeout = false; },
        GuardReason::timeout, GuardSource::wrench},
-      {"camera timeout", [](Rig& r) { r.in.deformation.timeout = true; }, [](Rig& r) { r.in.deformation.timeout = false; },
-       GuardReason::timeout, GuardSource::camera},
+      {"camera timeout", [](Rig& r) { r.in.deformation.timeout = true; },
+       [](Rig& r) { r.in.deformation.timeout = false; }, GuardReason::timeout, GuardSource::camera},
       // Stale: the source stops delivering; the injection runs the cycles up to its timeout
       // (20, 20, 80 past the camera's 20 ms latency, 500 ms), so the checked cycle is 1 ms past it.
-      {"stale gripper", [](Rig& r) { age(r, GuardSource::gripper, 20); }, [](Rig& r) { r.resume(GuardSource::gripper); },
-       GuardReason::stale_gripper, GuardSource::gripper},
+      {"stale gripper", [](Rig& r) { age(r, GuardSource::gripper, 20); },
+       [](Rig& r) { r.resume(GuardSource::gripper); }, GuardReason::stale_gripper, GuardSource::gripper},
       {"stale wrench", [](Rig& r) { age(r, GuardSource::wrench, 20); }, [](Rig& r) { r.resume(GuardSource::wrench); },
        GuardReason::stale_wrench, GuardSource::wrench},
       {"stale camera", [](Rig& r) { age(r, GuardSource::camera, 80); }, [](Rig& r) { r.resume(GuardSource::camera); },
        GuardReason::stale_camera, GuardSource::camera},
-      {"stale estimate", [](Rig& r) { age(r, GuardSource::estimate, 500); }, [](Rig& r) { r.resume(GuardSource::estimate); },
-       GuardReason::stale_estimate, GuardSource::estimate},
+      {"stale estimate", [](Rig& r) { age(r, GuardSource::estimate, 500); },
+       [](Rig& r) { r.resume(GuardSource::estimate); }, GuardReason::stale_estimate, GuardSource::estimate},
       {"nan clock", [](Rig& r) { r.in.now_s = kNaN; }, nothing, GuardReason::nan_input, GuardSource::clock},
   };
 }
@@ -282,7 +295,8 @@ TEST(GraspGuard, StaleWithinOneCycleOfTheTimeout) {
     const double age0 = c.source == GuardSource::camera ? 0.02 : 0.0;  // the camera's capture latency
     rig.hold(c.source);
     const int ok_cycles = static_cast<int>(std::floor((c.timeout - age0) * 1000 + 1e-9)) - 1;
-    for (int i = 0; i < ok_cycles; ++i) ASSERT_EQ(rig.cycle().verdict, GraspVerdict::ok) << i << " " << describe(rig.out);
+    for (int i = 0; i < ok_cycles; ++i)
+      ASSERT_EQ(rig.cycle().verdict, GraspVerdict::ok) << i << " " << describe(rig.out);
     rig.cycle();  // at the timeout itself, either is right
     EXPECT_TRUE(has(rig.cycle(), c.reason)) << describe(rig.out);
     EXPECT_NE(rig.out.verdict, GraspVerdict::ok);
@@ -347,9 +361,9 @@ TEST(GraspGuard, FrozenWrenchIsStale) {
 struct Limit {
   const char* name;
   std::function<void(GraspGuardConfig&)> configure;
-  std::function<void(Rig&)> cross;  ///< just past the threshold
+  std::function<void(Rig&)> cross;   ///< just past the threshold
   std::function<void(Rig&)> within;  ///< inside the hysteresis band: must not clear
-  std::function<void(Rig&)> below;  ///< below threshold x (1 - margin): clears
+  std::function<void(Rig&)> below;   ///< below threshold x (1 - margin): clears
   GuardReason reason;
   GraspVerdict verdict;
   StopAction action;
@@ -363,8 +377,8 @@ std::vector<Limit> limits() {
   auto strain_at = [](double e) { return [e](Rig& r) { r.in.deformation.strain = e; }; };
   auto closure_at = [](double c) { return [c](Rig& r) { r.squeeze(c); }; };
   return {
-      {"force limit", none, force_at(5.001), force_at(4.8), force_at(4.7), GuardReason::force_limit, GraspVerdict::limit,
-       StopAction::freeze, GuardReason::none},
+      {"force limit", none, force_at(5.001), force_at(4.8), force_at(4.7), GuardReason::force_limit,
+       GraspVerdict::limit, StopAction::freeze, GuardReason::none},
       {"force exceeded", [](GraspGuardConfig& c) { c.max_strain = kInf; }, force_at(11.01), force_at(10.5),
        force_at(10.4), GuardReason::force_exceeded, GraspVerdict::stop, StopAction::open, GuardReason::force_limit},
       {"strain limit", none, strain_at(0.1001), strain_at(0.096), strain_at(0.094), GuardReason::strain_limit,
@@ -372,8 +386,8 @@ std::vector<Limit> limits() {
       {"strain exceeded", none, strain_at(0.1101), strain_at(0.106), strain_at(0.104), GuardReason::strain_exceeded,
        GraspVerdict::stop, StopAction::open, GuardReason::strain_limit},
       {"indentation limit", [](GraspGuardConfig& c) { c.max_indentation_m = 0.0015; }, closure_at(0.00151),
-       closure_at(0.00144), closure_at(0.00142), GuardReason::indentation_limit, GraspVerdict::limit, StopAction::freeze,
-       GuardReason::none},
+       closure_at(0.00144), closure_at(0.00142), GuardReason::indentation_limit, GraspVerdict::limit,
+       StopAction::freeze, GuardReason::none},
       {"indentation exceeded",
        [](GraspGuardConfig& c) {
          c.max_indentation_m = 0.001;
@@ -381,8 +395,7 @@ std::vector<Limit> limits() {
        },
        closure_at(0.00111), closure_at(0.00106), closure_at(0.00104), GuardReason::indentation_exceeded,
        GraspVerdict::stop, StopAction::open, GuardReason::indentation_limit},
-      {"estimate uncertain (limit)",
-       [](GraspGuardConfig& c) { c.uncertain_estimate_verdict = GraspVerdict::limit; },
+      {"estimate uncertain (limit)", [](GraspGuardConfig& c) { c.uncertain_estimate_verdict = GraspVerdict::limit; },
        [](Rig& r) { r.in.estimate.msm_beta_std = 0.16; }, [](Rig& r) { r.in.estimate.msm_beta_std = 0.145; },
        [](Rig& r) { r.in.estimate.msm_beta_std = 0.14; }, GuardReason::estimate_uncertain, GraspVerdict::limit,
        StopAction::freeze, GuardReason::none},
@@ -738,7 +751,7 @@ TEST(GraspGuardInit, RejectsBadConfigurations) {
       [](GraspGuardConfig& c) { c.prediction_max_closure_m = 0.05; },  // past the object's extent
       [](GraspGuardConfig& c) { c.relax_max_iterations = 0; },
       [](GraspGuardConfig& c) { c.force_source = ForceSource::motor_current; },  // no gain
-      [](GraspGuardConfig& c) { c.contact_width_m = 0.2; },  // far from the 35 mm model
+      [](GraspGuardConfig& c) { c.contact_width_m = 0.2; },                      // far from the 35 mm model
   };
   for (std::size_t i = 0; i < breakers.size(); ++i) {
     GraspGuardConfig config = rig_config();
@@ -812,7 +825,8 @@ TEST(GraspGuardInit, NamesAreStable) {
   EXPECT_STREQ(guard_reason_name(GuardReason::stale_camera), "stale_camera");
   EXPECT_STREQ(grasp_verdict_name(GraspVerdict::limit), "limit");
   EXPECT_STREQ(guard_source_name(GuardSource::wrench), "wrench");
-  for (int r = 0; r < kGuardReasonCount; ++r) EXPECT_STRNE(guard_reason_name(static_cast<GuardReason>(r)), "unknown") << r;
+  for (int r = 0; r < kGuardReasonCount; ++r)
+    EXPECT_STRNE(guard_reason_name(static_cast<GuardReason>(r)), "unknown") << r;
 }
 
 }  // namespace

@@ -137,7 +137,7 @@ TYPED_TEST(MsmEffects, StiffeningMakesTheResponseSublinear) {
   const double stiff_small = sag(50.0, 10.0);
   const double stiff_large = sag(50.0, 20.0);
   EXPECT_EQ(plain_small, sag(0.0, 10.0));
-  EXPECT_LT(stiff_small, plain_small);  // stiffer under the same load...
+  EXPECT_LT(stiff_small, plain_small);                                     // stiffer under the same load...
   EXPECT_LT(stiff_large / stiff_small, plain_large / plain_small - 0.03);  // ...and more so as it grows
 }
 

@@ -216,7 +216,8 @@ TYPED_TEST(MsmStep, BadStepInputIsRejectedAndStateUnchanged) {
   ASSERT_EQ(f.status, Status::ok);
   pliant::MsmParams<T::FDim, typename T::Scalar> p;
   pliant::MsmStepInput<T::FDim, typename T::Scalar> in;
-  for (auto dt : {typename T::Scalar(0), typename T::Scalar(-1), std::numeric_limits<typename T::Scalar>::quiet_NaN()}) {
+  for (auto dt :
+       {typename T::Scalar(0), typename T::Scalar(-1), std::numeric_limits<typename T::Scalar>::quiet_NaN()}) {
     in.dt = dt;
     EXPECT_EQ(pliant::msm_step(f.model, p, in, f.state), Status::invalid_argument);
   }

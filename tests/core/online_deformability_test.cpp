@@ -17,7 +17,8 @@ pliant::OnlineDeformabilityEstimate run_online(const pliant::test::PressExperime
   std::vector<unsigned char> block(pliant::online_deformability_workspace_size(f.model, config));
   pliant::Arena arena(block.data(), block.size());
   pliant::OnlineDeformability<Dim, Scalar> online;
-  EXPECT_EQ(pliant::online_deformability_init(arena, f.model, pliant::MsmParams<Dim, Scalar>{}, config, online), Status::ok);
+  EXPECT_EQ(pliant::online_deformability_init(arena, f.model, pliant::MsmParams<Dim, Scalar>{}, config, online),
+            Status::ok);
   const auto obs = experiment.observations();
   using Vec = Eigen::Matrix<Scalar, Dim, 1>;
   std::vector<Vec> frame(static_cast<std::size_t>(obs.particle_count));
@@ -25,8 +26,8 @@ pliant::OnlineDeformabilityEstimate run_online(const pliant::test::PressExperime
     for (int i = 0; i < obs.particle_count; ++i) frame[static_cast<std::size_t>(i)] = obs.point(k, i);
     const Vec target = obs.point(k, experiment.tool);
     const pliant::MsmDrivenTargets<Dim, Scalar> driven{&experiment.tool, &target, 1};
-    EXPECT_EQ(pliant::online_deformability_update(f.model, online, static_cast<Scalar>(obs.times_s[k] - obs.times_s[k - 1]),
-                                                  driven, frame.data()),
+    EXPECT_EQ(pliant::online_deformability_update(
+                  f.model, online, static_cast<Scalar>(obs.times_s[k] - obs.times_s[k - 1]), driven, frame.data()),
               Status::ok);
   }
   return pliant::online_deformability_estimate(online);
@@ -57,18 +58,22 @@ TEST(OnlineDeformability, NoEvidenceMeansNoConfidence) {
   std::vector<unsigned char> block(pliant::online_deformability_workspace_size(f.model, config));
   pliant::Arena arena(block.data(), block.size());
   pliant::OnlineDeformability<2, double> online;
-  ASSERT_EQ(pliant::online_deformability_init(arena, f.model, pliant::MsmParams<2, double>{}, config, online), Status::ok);
+  ASSERT_EQ(pliant::online_deformability_init(arena, f.model, pliant::MsmParams<2, double>{}, config, online),
+            Status::ok);
   EXPECT_FALSE(std::isfinite(pliant::online_deformability_estimate(online).msm_beta_std));
 
   std::vector<Eigen::Vector2d> hidden(32, Eigen::Vector2d::Constant(std::nan("")));
   const pliant::MsmDrivenTargets<2, double> none{};
-  EXPECT_EQ(pliant::online_deformability_update(f.model, online, 1.0 / 30, none, hidden.data()), Status::no_observations);
+  EXPECT_EQ(pliant::online_deformability_update(f.model, online, 1.0 / 30, none, hidden.data()),
+            Status::no_observations);
   EXPECT_EQ(online.empty_frames, 1u);
-  EXPECT_EQ(pliant::online_deformability_update(f.model, online, std::nan(""), none, hidden.data()), Status::invalid_argument);
+  EXPECT_EQ(pliant::online_deformability_update(f.model, online, std::nan(""), none, hidden.data()),
+            Status::invalid_argument);
   EXPECT_EQ(online.rejected_frames, 1u);
   pliant::OnlineDeformabilityConfig bad;
   bad.candidates = 2;
-  EXPECT_EQ(pliant::online_deformability_init(arena, f.model, pliant::MsmParams<2, double>{}, bad, online), Status::invalid_argument);
+  EXPECT_EQ(pliant::online_deformability_init(arena, f.model, pliant::MsmParams<2, double>{}, bad, online),
+            Status::invalid_argument);
 }
 
 }  // namespace

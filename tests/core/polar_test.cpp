@@ -46,7 +46,8 @@ TEST(Polar3d, MatchesSvdFromAColdStart) {
   for (int trial = 0; trial < 300; ++trial) {
     const Eigen::Matrix3d rot = (Eigen::AngleAxisd(angle(rng), Eigen::Vector3d::UnitX()) *
                                  Eigen::AngleAxisd(angle(rng), Eigen::Vector3d::UnitY()) *
-                                 Eigen::AngleAxisd(angle(rng), Eigen::Vector3d::UnitZ())).toRotationMatrix();
+                                 Eigen::AngleAxisd(angle(rng), Eigen::Vector3d::UnitZ()))
+                                    .toRotationMatrix();
     Eigen::Matrix3d s = Eigen::Vector3d(stretch(rng), stretch(rng), stretch(rng)).asDiagonal();
     const Eigen::Matrix3d a = rot * s;
     Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
@@ -66,8 +67,8 @@ TEST(Polar3d, WarmStartConvergesInFewIterations) {
 TEST(Polar2d, DegenerateInputsGiveRotations) {
   const Eigen::Matrix2d cases[] = {
       Eigen::Matrix2d::Zero(),
-      (Eigen::Matrix2d() << 1, 2, 2, 4).finished(),     // rank 1: collinear cluster
-      (Eigen::Matrix2d() << 1, 0, 0, -1).finished(),    // reflection, no rotational content
+      (Eigen::Matrix2d() << 1, 2, 2, 4).finished(),        // rank 1: collinear cluster
+      (Eigen::Matrix2d() << 1, 0, 0, -1).finished(),       // reflection, no rotational content
       (Eigen::Matrix2d() << -1, 0.2, 0.1, -1).finished(),  // inverted by 180 degrees
       (Eigen::Matrix2d() << 1e-300, 0, 0, 1e-300).finished(),
   };
@@ -85,9 +86,9 @@ TEST(Polar3d, DegenerateInputsGiveRotations) {
   const Eigen::Matrix3d cases[] = {
       Eigen::Matrix3d::Zero(),
       flat,
-      u * Eigen::Vector3d(0.5, -1, 2).transpose(),                  // collinear cluster
-      Eigen::Vector3d(1, 1, -1).asDiagonal().toDenseMatrix(),      // inverted (reflection)
-      -Eigen::Matrix3d::Identity(),                                  // point inversion
+      u * Eigen::Vector3d(0.5, -1, 2).transpose(),             // collinear cluster
+      Eigen::Vector3d(1, 1, -1).asDiagonal().toDenseMatrix(),  // inverted (reflection)
+      -Eigen::Matrix3d::Identity(),                            // point inversion
       Eigen::Matrix3d::Identity() * 1e-200,
   };
   for (const auto& a : cases) {

@@ -48,7 +48,8 @@ struct PressExperiment {
       times.push_back(t);
       for (int i = 0; i < n; ++i) {
         for (int d = 0; d < Dim; ++d) {
-          positions.push_back(static_cast<Scalar>(static_cast<double>(truth.state.position[i](d)) + noise_std * normal(rng)));
+          positions.push_back(
+              static_cast<Scalar>(static_cast<double>(truth.state.position[i](d)) + noise_std * normal(rng)));
         }
       }
     };

@@ -249,8 +249,8 @@ TYPED_TEST(TrackerTest, BadFramesAreRefusedAndCounted) {
   const typename Rig::Vec target = rig.true_position(1, rig.truth.tool);
   TrackerFrame<Rig::Dim, Scalar> in;
   in.driven = {&rig.truth.tool, &target, 1};
-  for (Scalar dt : {Scalar(0), Scalar(-0.1), std::numeric_limits<Scalar>::quiet_NaN(),
-                    std::numeric_limits<Scalar>::infinity()}) {
+  for (Scalar dt :
+       {Scalar(0), Scalar(-0.1), std::numeric_limits<Scalar>::quiet_NaN(), std::numeric_limits<Scalar>::infinity()}) {
     in.dt = dt;
     EXPECT_EQ(tracker_update(rig.fixture.model, rig.tracker, in), Status::invalid_argument);
   }

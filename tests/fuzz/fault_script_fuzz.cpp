@@ -38,11 +38,13 @@ std::string print(const FaultScript& script) {
         n = std::snprintf(line, sizeof line, "%.17g %s %s %.17g\n", e.start_s, pliant::hal::fault_kind_name(e.kind),
                           pliant::hal::fault_device_name(device), e.duration_s);
       } else if (e.kind == FaultKind::fault_bits) {
-        n = std::snprintf(line, sizeof line, "%.17g %s %s %.17g 0x%lx\n", e.start_s, pliant::hal::fault_kind_name(e.kind),
-                          pliant::hal::fault_device_name(device), e.duration_s, static_cast<unsigned long>(e.value));
+        n = std::snprintf(line, sizeof line, "%.17g %s %s %.17g 0x%lx\n", e.start_s,
+                          pliant::hal::fault_kind_name(e.kind), pliant::hal::fault_device_name(device), e.duration_s,
+                          static_cast<unsigned long>(e.value));
       } else {
-        n = std::snprintf(line, sizeof line, "%.17g %s %s %.17g %.17g\n", e.start_s, pliant::hal::fault_kind_name(e.kind),
-                          pliant::hal::fault_device_name(device), e.duration_s, e.value);
+        n = std::snprintf(line, sizeof line, "%.17g %s %s %.17g %.17g\n", e.start_s,
+                          pliant::hal::fault_kind_name(e.kind), pliant::hal::fault_device_name(device), e.duration_s,
+                          e.value);
       }
       check(n > 0 && static_cast<std::size_t>(n) < sizeof line);
       text += line;
@@ -85,7 +87,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   for (int d = 0; d < pliant::hal::kFaultDeviceCount; ++d) {
     const auto device = static_cast<FaultDevice>(d);
     check(script.of(device).size() == again.of(device).size());
-    for (int i = 0; i < script.of(device).size(); ++i) check(same_event(script.of(device).event(i), again.of(device).event(i)));
+    for (int i = 0; i < script.of(device).size(); ++i)
+      check(same_event(script.of(device).event(i), again.of(device).event(i)));
   }
   return 0;
 }

@@ -56,8 +56,8 @@ void check_mesh(const TetMesh& mesh, const MeshReadReport& report) {
     const double u[3] = {p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]};
     const double v[3] = {p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]};
     const double w[3] = {p[3][0] - p[0][0], p[3][1] - p[0][1], p[3][2] - p[0][2]};
-    const double det = u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
-                       u[2] * (v[0] * w[1] - v[1] * w[0]);
+    const double det =
+        u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) + u[2] * (v[0] * w[1] - v[1] * w[0]);
     if (!(det > 0.0)) __builtin_trap();
   }
   if (report.unused_points < 0 || static_cast<std::size_t>(report.unused_points) > points ||
@@ -97,8 +97,7 @@ void run_msh(std::string_view text) {
 void run_tetgen(std::string_view text) {
   const std::size_t separator = text.find('\0');
   const std::string_view node = text.substr(0, separator);
-  const std::string_view ele =
-      separator == std::string_view::npos ? std::string_view() : text.substr(separator + 1);
+  const std::string_view ele = separator == std::string_view::npos ? std::string_view() : text.substr(separator + 1);
   attempt([&] {
     pliant::host::TetGenNodes nodes = pliant::host::parse_tetgen_node(node, "fuzz.node");
     MeshReadReport report;

@@ -50,8 +50,7 @@ bool attempt(Parse&& parse) {
 void check_finalized(const Recording& r) {
   const auto n = static_cast<std::size_t>(r.particle_count);
   const auto dimension = static_cast<std::size_t>(r.dimension);
-  if (r.frame_times_s.empty() || r.masses.size() != n ||
-      r.positions.size() != r.frame_times_s.size() * n * dimension ||
+  if (r.frame_times_s.empty() || r.masses.size() != n || r.positions.size() != r.frame_times_s.size() * n * dimension ||
       r.rest_positions.size() != n * dimension) {
     __builtin_trap();
   }

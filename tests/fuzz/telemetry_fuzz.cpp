@@ -59,11 +59,12 @@ void check_and_reencode(const pliant_tm_message_t& m, const pliant_tm_decoder_t&
       size = pliant_tm_encode_verdict(&encoder, m.header.stamp_us, &v, frame, sizeof frame);
       check(size == 68);
       const pliant_tm_verdict_t back = decode_frame(again, frame, static_cast<std::size_t>(size)).body.verdict;
-      const float* a[10] = {&v.closure_m, &v.force_n, &v.strain, &v.allowed_force_n, &v.predicted_strain,
-                            &v.safe_closure_m, &v.safe_width_m, &v.predicted_force_n, &v.beta_low, &v.beta_high};
-      const float* b[10] = {&back.closure_m, &back.force_n, &back.strain, &back.allowed_force_n,
-                            &back.predicted_strain, &back.safe_closure_m, &back.safe_width_m,
-                            &back.predicted_force_n, &back.beta_low, &back.beta_high};
+      const float* a[10] = {&v.closure_m,        &v.force_n,        &v.strain,       &v.allowed_force_n,
+                            &v.predicted_strain, &v.safe_closure_m, &v.safe_width_m, &v.predicted_force_n,
+                            &v.beta_low,         &v.beta_high};
+      const float* b[10] = {&back.closure_m,        &back.force_n,        &back.strain,       &back.allowed_force_n,
+                            &back.predicted_strain, &back.safe_closure_m, &back.safe_width_m, &back.predicted_force_n,
+                            &back.beta_low,         &back.beta_high};
       for (int i = 0; i < 10; ++i) check(same(a[i], b[i], 4));
       check(back.verdict == v.verdict && back.reason == v.reason && back.stop_action == v.stop_action &&
             back.fault_sources == v.fault_sources && back.reasons == v.reasons && back.flags == v.flags);
@@ -121,7 +122,8 @@ void cobs_round_trip(const std::uint8_t* data, std::size_t size) {
   check(n > 0 && static_cast<std::size_t>(n) <= (size == 0 ? 1 : size + (size + 253) / 254));
   for (std::int32_t i = 0; i < n; ++i) check(encoded[static_cast<std::size_t>(i)] != 0);
   decoded.resize(static_cast<std::size_t>(n));
-  const std::int32_t m = pliant_tm_cobs_decode(encoded.data(), static_cast<std::size_t>(n), decoded.data(), decoded.size());
+  const std::int32_t m =
+      pliant_tm_cobs_decode(encoded.data(), static_cast<std::size_t>(n), decoded.data(), decoded.size());
   check(m == static_cast<std::int32_t>(size));
   check(size == 0 || std::memcmp(decoded.data(), data, size) == 0);
 }

@@ -122,8 +122,8 @@ TEST(HalAllocation, FaultyCameraReadsAllocateNothing) {
   for (FaultKind kind : {FaultKind::drop, FaultKind::freeze_data, FaultKind::freeze_stamp, FaultKind::disconnect}) {
     EXPECT_GT(color.fault_counters().of(kind), 0u) << fault_kind_name(kind);
   }
-  for (FaultKind kind : {FaultKind::nan, FaultKind::freeze_data, FaultKind::stamp_jump, FaultKind::fault_bits,
-                         FaultKind::timeout}) {
+  for (FaultKind kind :
+       {FaultKind::nan, FaultKind::freeze_data, FaultKind::stamp_jump, FaultKind::fault_bits, FaultKind::timeout}) {
     EXPECT_GT(depth.fault_counters().of(kind), 0u) << fault_kind_name(kind);
   }
 }
@@ -147,7 +147,8 @@ TEST(HalAllocation, ReplayReadsAllocateNothing) {
   ReplayForceTorque ft(wrench, t.clock);
   ReplayGripper g(gripper, t.clock);
   ReplayParticleObserver o(particles, 3, t.clock);
-  const std::string script = "1.2 nan ft 0.1\n1.3 occlude observer 0.2\n1.4 freeze_stamp gripper 0.1\n1.6 timeout ft 0.05\n";
+  const std::string script =
+      "1.2 nan ft 0.1\n1.3 occlude observer 0.2\n1.4 freeze_stamp gripper 0.1\n1.6 timeout ft 0.05\n";
   FaultScript faults;
   FaultScriptError error;
   ASSERT_EQ(parse_fault_script(script.data(), script.size(), faults, error), HalStatus::ok);

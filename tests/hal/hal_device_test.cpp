@@ -134,16 +134,21 @@ TEST(HalDevice, FailedConfigureLeavesTheDeviceUnconfigured) {
 TEST(HalDevice, CountsDropsFaultsAndReconnects) {
   ScriptedSensor s;
   const ScriptedSensor::Answer script[] = {
-      {HalStatus::ok, 1, 0},           {HalStatus::ok, 2, 0},
-      {HalStatus::ok, 5, 0},           // 3 and 4 dropped
-      {HalStatus::ok, 6, kFtSupplyLow},  // a fault sample
+      {HalStatus::ok, 1, 0},
+      {HalStatus::ok, 2, 0},
+      {HalStatus::ok, 5, 0},               // 3 and 4 dropped
+      {HalStatus::ok, 6, kFtSupplyLow},    // a fault sample
       {HalStatus::ok, 7, kFtCanBusError},  // degraded, not in the fault mask
-      {HalStatus::timeout, 0, 0},      {HalStatus::bus_off, 0, 0},
-      {HalStatus::disconnected, 0, 0}, {HalStatus::disconnected, 0, 0},
-      {HalStatus::no_data, 0, 0},      // not proof of a reconnect (may be a driver's back-off)
-      {HalStatus::ok, 8, 0},           // back: a reconnect
-      {HalStatus::io_error, 0, 0},     {HalStatus::device_fault, 0, 0},
-      {HalStatus::disconnected, 0, 0}, {HalStatus::ok, 12, 0},  // a second outage; 9-11 lost
+      {HalStatus::timeout, 0, 0},
+      {HalStatus::bus_off, 0, 0},
+      {HalStatus::disconnected, 0, 0},
+      {HalStatus::disconnected, 0, 0},
+      {HalStatus::no_data, 0, 0},  // not proof of a reconnect (may be a driver's back-off)
+      {HalStatus::ok, 8, 0},       // back: a reconnect
+      {HalStatus::io_error, 0, 0},
+      {HalStatus::device_fault, 0, 0},
+      {HalStatus::disconnected, 0, 0},
+      {HalStatus::ok, 12, 0},  // a second outage; 9-11 lost
   };
   for (const ScriptedSensor::Answer& a : script) s.answers.push_back(a);
   ASSERT_EQ(s.configure(), HalStatus::ok);
@@ -174,7 +179,8 @@ TEST(HalDevice, CountsDropsFaultsAndReconnects) {
 
 TEST(HalDevice, FailedReadLeavesTheCallersSampleUntouched) {
   ScriptedSensor s;
-  for (const ScriptedSensor::Answer& a : {ScriptedSensor::Answer{HalStatus::ok, 1, 0}, ScriptedSensor::Answer{HalStatus::timeout, 9, 0}}) {
+  for (const ScriptedSensor::Answer& a :
+       {ScriptedSensor::Answer{HalStatus::ok, 1, 0}, ScriptedSensor::Answer{HalStatus::timeout, 9, 0}}) {
     s.answers.push_back(a);
   }
   ASSERT_EQ(s.configure(), HalStatus::ok);

@@ -72,7 +72,7 @@ TEST(HalFaultyCameras, DepthFaultsFromAScriptAreAppliedAndCounted) {
   ASSERT_EQ(statuses[3], HalStatus::ok);
   for (std::uint16_t d : pixels[3]) EXPECT_GT(d, 0);  // back to normal
   ASSERT_EQ(statuses[4], HalStatus::ok);
-  EXPECT_EQ(pixels[4], pixels[3]);  // freeze_data: frame 3's pixels
+  EXPECT_EQ(pixels[4], pixels[3]);                    // freeze_data: frame 3's pixels
   EXPECT_NEAR(frames[4].header.stamp_s, 1.04, 1e-9);  // under its own stamp
   EXPECT_EQ(frames[4].header.sequence, frames[3].header.sequence + 1);
   ASSERT_EQ(statuses[5], HalStatus::ok);
@@ -123,7 +123,8 @@ TEST(HalFaultyCameras, ColourFramesFreezeBitForBitAndRefuseNan) {
   c.period_s = 0.010;
   MockColorCamera inner(t.clock, c);
   FaultyColorCamera camera(inner, t.clock, 8 * 6 * 3);
-  EXPECT_EQ(camera.set_fault_schedule(script_for("1.0 nan depth 1\n", FaultDevice::depth_camera)), HalStatus::unsupported);
+  EXPECT_EQ(camera.set_fault_schedule(script_for("1.0 nan depth 1\n", FaultDevice::depth_camera)),
+            HalStatus::unsupported);
   FaultSchedule bus_off;
   FaultEvent e;
   e.kind = FaultKind::bus_off;

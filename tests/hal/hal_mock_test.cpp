@@ -134,8 +134,8 @@ TEST(HalMockGripper, RefusesBadCommands) {
 
 // Every sample fault, on a window covering exactly the samples at 1.011 .. 1.015 s.
 TEST(HalMockGripper, SampleFaultsHitExactlyTheScheduledSamples) {
-  const FaultKind kinds[] = {FaultKind::drop, FaultKind::freeze_data, FaultKind::freeze_stamp, FaultKind::nan,
-                             FaultKind::stamp_jump, FaultKind::fault_bits};
+  const FaultKind kinds[] = {FaultKind::drop, FaultKind::freeze_data, FaultKind::freeze_stamp,
+                             FaultKind::nan,  FaultKind::stamp_jump,  FaultKind::fault_bits};
   for (FaultKind kind : kinds) {
     SCOPED_TRACE(fault_kind_name(kind));
     GripperRig rig;
@@ -234,7 +234,7 @@ TEST(HalMockGripper, ModbusTimeoutFailsReadsAndWritesAndTheLastCommandRuns) {
   EXPECT_EQ(rig.gripper.counters().timeouts, 11u);
   EXPECT_EQ(rig.gripper.fault_counters().of(FaultKind::timeout), 11u);
   EXPECT_EQ(rig.gripper.counters().dropped, 1u + 10u);  // sample 0, never read, and those due during the outage
-  EXPECT_LT(rig.plant.width_m(), 0.034 - 0.0002);  // the freeze never arrived
+  EXPECT_LT(rig.plant.width_m(), 0.034 - 0.0002);       // the freeze never arrived
   EXPECT_EQ(rig.gripper.add_fault(event(FaultKind::bus_off, 2, 1)), HalStatus::unsupported);
   EXPECT_EQ(rig.gripper.add_fault(event(FaultKind::drop, 2, 0)), HalStatus::invalid_argument);
 }
@@ -458,9 +458,9 @@ TEST(HalMockObserver, OcclusionAndFrameFaults) {
   c.occlusion_fraction = 0.25;
   ObserverRig rig(c);
   ASSERT_EQ(rig.observer->add_fault(event(FaultKind::occlude, 1.0395, 0.020, 0.75)), HalStatus::ok);  // frames 4, 5
-  ASSERT_EQ(rig.observer->add_fault(event(FaultKind::freeze_data, 1.0595, 0.020)), HalStatus::ok);   // frames 6, 7
-  ASSERT_EQ(rig.observer->add_fault(event(FaultKind::nan, 1.0795, 0.010)), HalStatus::ok);           // frame 8
-  ASSERT_EQ(rig.observer->add_fault(event(FaultKind::fault_bits, 1.0895, 0.010)), HalStatus::ok);    // frame 9
+  ASSERT_EQ(rig.observer->add_fault(event(FaultKind::freeze_data, 1.0595, 0.020)), HalStatus::ok);    // frames 6, 7
+  ASSERT_EQ(rig.observer->add_fault(event(FaultKind::nan, 1.0795, 0.010)), HalStatus::ok);            // frame 8
+  ASSERT_EQ(rig.observer->add_fault(event(FaultKind::fault_bits, 1.0895, 0.010)), HalStatus::ok);     // frame 9
   ASSERT_EQ(rig.observer->add_fault(event(FaultKind::bus_off, 1, 1)), HalStatus::unsupported);
   const int n = rig.plant.particle_count();
   const int hidden = static_cast<int>(std::lround(0.25 * n));
@@ -563,7 +563,7 @@ TEST(HalMockCameras, DepthFramesHaveThePlaneAndNaNMeansNoMeasurement) {
   c.tilt_m_per_px = 0;
   MockDepthCamera camera(t.clock, c);
   ASSERT_EQ(camera.configure(), HalStatus::ok);
-  ASSERT_EQ(camera.add_fault(event(FaultKind::nan, 1.0095, 0.010)), HalStatus::ok);  // frame 1
+  ASSERT_EQ(camera.add_fault(event(FaultKind::nan, 1.0095, 0.010)), HalStatus::ok);              // frame 1
   ASSERT_EQ(camera.add_fault(event(FaultKind::stamp_jump, 1.0195, 0.010, 2.0)), HalStatus::ok);  // frame 2
   ASSERT_EQ(camera.start(), HalStatus::ok);
   DepthFrame f;
@@ -594,14 +594,15 @@ TEST(HalFaultSchedule, ValidatesEventsAndOverlaps) {
   EXPECT_EQ(s.add(event(FaultKind::fault_bits, 0, 1, 1.5)), HalStatus::invalid_argument);
   EXPECT_EQ(s.add(event(FaultKind::fault_bits, 0, 1, -1)), HalStatus::invalid_argument);
   EXPECT_EQ(s.add(event(FaultKind::occlude, 0, 1, 0)), HalStatus::invalid_argument);
-  EXPECT_EQ(s.add(event(FaultKind::stamp_jump, 0, 1, std::numeric_limits<double>::infinity())), HalStatus::invalid_argument);
+  EXPECT_EQ(s.add(event(FaultKind::stamp_jump, 0, 1, std::numeric_limits<double>::infinity())),
+            HalStatus::invalid_argument);
   EXPECT_EQ(s.size(), 0);
   EXPECT_EQ(s.add(event(FaultKind::stamp_jump, 1.0, 1.0, 0.1)), HalStatus::ok);
   EXPECT_EQ(s.add(event(FaultKind::stamp_jump, 1.5, 1.0, 0.2)), HalStatus::ok);
   EXPECT_EQ(s.add(event(FaultKind::nan, 1.5, 0.5)), HalStatus::ok);
   const ActiveFaults a = s.active_at(1.7);
   EXPECT_TRUE(a.has(FaultKind::stamp_jump) && a.has(FaultKind::nan));
-  EXPECT_EQ(a.value[static_cast<int>(FaultKind::stamp_jump)], 0.1);  // the first added wins
+  EXPECT_EQ(a.value[static_cast<int>(FaultKind::stamp_jump)], 0.1);     // the first added wins
   EXPECT_EQ(s.active_at(2.0).kinds, fault_bit(FaultKind::stamp_jump));  // [start, end)
   EXPECT_EQ(s.active_at(2.5).kinds, 0u);
   EXPECT_EQ(s.active_at(0.99).kinds, 0u);

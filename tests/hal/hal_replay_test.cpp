@@ -231,7 +231,8 @@ TEST(HalReplay, MalformedChannelsAreRefused) {
 
   const RecordedChannel one_width{{0.0}, {0.05, 1.0}, 2};
   ReplayGripper gripper_bus_off(one_width, clock);
-  EXPECT_EQ(gripper_bus_off.add_fault({0.0, 1.0, FaultKind::bus_off, kNaN}), HalStatus::ok);  // unchecked until configure
+  EXPECT_EQ(gripper_bus_off.add_fault({0.0, 1.0, FaultKind::bus_off, kNaN}),
+            HalStatus::ok);  // unchecked until configure
   EXPECT_EQ(gripper_bus_off.configure(), HalStatus::unsupported);
 }
 

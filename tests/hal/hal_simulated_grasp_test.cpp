@@ -71,7 +71,8 @@ TEST(HalSimulatedGrasp, TrueStrainMatchesSvdOfKnownDeformations) {
   maps[2] = Eigen::Matrix3d::Identity();
   for (const Eigen::Matrix3d& f : maps) {
     std::vector<Eigen::Vector3d> x(static_cast<std::size_t>(n));
-    for (int i = 0; i < n; ++i) x[static_cast<std::size_t>(i)] = rotation * f * plant.rest_positions()[i] + Eigen::Vector3d(0.1, -0.2, 0.3);
+    for (int i = 0; i < n; ++i)
+      x[static_cast<std::size_t>(i)] = rotation * f * plant.rest_positions()[i] + Eigen::Vector3d(0.1, -0.2, 0.3);
     // A dynamic-size SVD (GCC 12 warns falsely on the fixed-size one's members).
     const Eigen::MatrixXd dynamic = f;
     Eigen::JacobiSVD<Eigen::MatrixXd> svd(dynamic);

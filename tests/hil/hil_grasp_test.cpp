@@ -15,8 +15,8 @@
 //    frozen, silent, NaN, faulted and time-jumping F/T; CAN bus-off; Modbus timeout; NaN,
 //    faulted, stale and disconnected gripper) injected through the mocks' fault schedules at
 //    two points of the squeeze (25 % and 65 % of the way from contact to the nominal first
-//    limit) on four objects (msm_beta 0.75, 0.55, 0.25, 0.10), each run 100 cycles past onset. The verdict is not ok within 2 control cycles
-//    of the fault's onset every time: in the onset cycle or the next. The onset is the first
+//    limit) on four objects (msm_beta 0.75, 0.55, 0.25, 0.10), each run 100 cycles past onset. The verdict is not ok
+//    within 2 control cycles of the fault's onset every time: in the onset cycle or the next. The onset is the first
 //    cycle in which a device delivers the fault (its fault counter moves): a camera fault
 //    scheduled between frames shows with the next frame, which is also printed.
 // Under PLIANT_SANITIZE (ASan/UBSan, several times slower) the table runs on 4 of the objects
@@ -106,10 +106,13 @@ TEST(HilGraspGuard, SoftToStiffObjectsStopBeforeTheirLimit) {
   std::vector<HilObject> objects = hil_objects();
   ASSERT_GE(objects.size(), 10u);
   if (reduced()) objects = {objects[2], objects[5], objects[8], objects[11]};  // beta 0.75, 0.5, 0.25, 0.1
-  std::printf("\nHIL grasp guard: %zu objects, 1 kHz control, 30 Hz camera; strain margin %.0f %% (guard limit = %.2f x object limit)\n",
-              objects.size(), 100 * kStrainMargin, 1 - kStrainMargin);
+  std::printf(
+      "\nHIL grasp guard: %zu objects, 1 kHz control, 30 Hz camera; strain margin %.0f %% (guard limit = %.2f x object "
+      "limit)\n",
+      objects.size(), 100 * kStrainMargin, 1 - kStrainMargin);
   std::printf("%-16s %-8s %4s %5s %13s %6s %8s %8s %9s %-18s %-16s %6s %6s\n", "object", "shape", "n", "beta",
-              "est beta", "limit", "at stop", "peak", "overshoot", "first not-ok", "verdict at end", "squeeze", "cycles");
+              "est beta", "limit", "at stop", "peak", "overshoot", "first not-ok", "verdict at end", "squeeze",
+              "cycles");
   double worst = -1;
   for (const HilObject& object : objects) {
     SCOPED_TRACE(object.name);
@@ -232,7 +235,8 @@ TEST(HilGraspGuard, EveryFaultIsNotOkWithinTwoCycles) {
         Rig rig(object, options);
         ASSERT_EQ(rig.status, hal::HalStatus::ok);
         // Half a period before a cycle, so that the start is never a rounding tie.
-        const long start_cycle = base.contact + static_cast<long>(fraction * static_cast<double>(base.first_not_ok - base.contact));
+        const long start_cycle =
+            base.contact + static_cast<long>(fraction * static_cast<double>(base.first_not_ok - base.contact));
         hal::FaultEvent e;
         e.kind = f.kind;
         e.start_s = 10.0 + (static_cast<double>(start_cycle + 1) - 0.5) * period;
@@ -280,16 +284,18 @@ TEST(HilGraspGuard, EveryFaultIsNotOkWithinTwoCycles) {
       }
     }
   }
-  std::printf("\nHIL fault detection (%zu objects x %zu onsets each; latency = cycles from the first faulty delivery to not ok)\n",
-              objects.size(), fractions.size());
+  std::printf(
+      "\nHIL fault detection (%zu objects x %zu onsets each; latency = cycles from the first faulty delivery to not "
+      "ok)\n",
+      objects.size(), fractions.size());
   std::printf("%-22s %-8s %-13s %5s %16s %18s  %s\n", "fault", "device", "kind", "runs", "latency (cycles)",
               "from start (cycles)", "verdict / reason");
   const char* devices[] = {"gripper", "F/T", "camera"};
   for (std::size_t k = 0; k < cases.size(); ++k) {
     const Latency& l = latency[k];
-    std::printf("%-22s %-8s %-13s %5ld %16ld %18ld  %s / %s\n", cases[k].name, devices[static_cast<int>(cases[k].target)],
-                hal::fault_kind_name(cases[k].kind), l.runs, l.worst, l.worst_from_start, grasp_verdict_name(l.verdict),
-                guard_reason_name(l.reason));
+    std::printf("%-22s %-8s %-13s %5ld %16ld %18ld  %s / %s\n", cases[k].name,
+                devices[static_cast<int>(cases[k].target)], hal::fault_kind_name(cases[k].kind), l.runs, l.worst,
+                l.worst_from_start, grasp_verdict_name(l.verdict), guard_reason_name(l.reason));
   }
 }
 

@@ -97,7 +97,8 @@ Rig::Rig(const HilObject& object, const RigOptions& rig_options) : options(rig_o
     status = d->configure();
     if (status != hal::HalStatus::ok) return;
   }
-  supervisor = std::make_unique<Supervisor>(*gripper, *wrench, *observer, clock, hil_supervisor_config(object, options));
+  supervisor =
+      std::make_unique<Supervisor>(*gripper, *wrench, *observer, clock, hil_supervisor_config(object, options));
   status = supervisor->start();
 }
 

@@ -28,10 +28,10 @@ struct HilObject {
 std::vector<HilObject> hil_objects();
 
 struct RigOptions {
-  double rate_hz = 1000;           ///< control loop (and gripper, F/T sample) rate
+  double rate_hz = 1000;  ///< control loop (and gripper, F/T sample) rate
   double camera_rate_hz = 30;
   double camera_noise_m = 3e-5;
-  double pregrasp_gap_m = 0.008;   ///< the gripper starts this much wider than the object
+  double pregrasp_gap_m = 0.008;  ///< the gripper starts this much wider than the object
   /// The guard's prediction table (init cost ~ beta points x (closure points + 8) relaxations).
   int prediction_beta_points = 11;
   int prediction_closure_points = 32;

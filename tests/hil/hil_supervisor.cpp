@@ -60,7 +60,8 @@ bool Supervisor::build() {
   for (int i = 0; i < n; ++i) {
     const auto u = static_cast<std::size_t>(i);
     if (rest_count_[u] == 0) return false;  // a particle never seen: no rest shape for it
-    for (int d = 0; d < 3; ++d) rest_[3 * u + static_cast<std::size_t>(d)] = rest_sum_[3 * u + static_cast<std::size_t>(d)] / rest_count_[u];
+    for (int d = 0; d < 3; ++d)
+      rest_[3 * u + static_cast<std::size_t>(d)] = rest_sum_[3 * u + static_cast<std::size_t>(d)] / rest_count_[u];
     low = std::min(low, rest_[3 * u]);
     high = std::max(high, rest_[3 * u]);
     all_[u] = i;
@@ -82,7 +83,8 @@ bool Supervisor::build() {
   MsmParams<3, double> base;
   estimator_block_.assign(online_deformability_workspace_size(model_, config_.estimator), 0);
   Arena estimator_arena(estimator_block_.data(), estimator_block_.size());
-  if (online_deformability_init(estimator_arena, model_, base, config_.estimator, estimator_) != Status::ok) return false;
+  if (online_deformability_init(estimator_arena, model_, base, config_.estimator, estimator_) != Status::ok)
+    return false;
   observed_.assign(static_cast<std::size_t>(n), Vec::Zero());
   driven_ids_.assign(static_cast<std::size_t>(n), 0);
   driven_targets_.assign(static_cast<std::size_t>(n), Vec::Zero());
@@ -97,13 +99,15 @@ void Supervisor::on_frame(const hal::ParticleFrame& frame, std::uint32_t flags) 
   std::uint32_t bits = frame.header.status_bits | flags;
   if (frame.dimension == 3 && frame.particle_count == n && frame.positions != nullptr) {
     for (int i = 0; i < n; ++i) {
-      observed_[static_cast<std::size_t>(i)] = Vec(frame.positions[3 * i], frame.positions[3 * i + 1], frame.positions[3 * i + 2]);
+      observed_[static_cast<std::size_t>(i)] =
+          Vec(frame.positions[3 * i], frame.positions[3 * i + 1], frame.positions[3 * i + 2]);
     }
     GraspStrainMeasurement measured;
     if (grasp_guard_measure_strain(model_, guard_, observed_.data(), measured) == Status::ok) strain = measured.strain;
     // Only trustworthy frames teach the estimator (a frozen or stalled frame would bias it).
-    const bool usable = (bits & (hal::kStreamFaultMask | hal::kFrameFaultMask)) == 0 && std::isfinite(frame.header.stamp_s) &&
-                        has_frame_stamp_ && frame.header.stamp_s > last_frame_stamp_s_;
+    const bool usable = (bits & (hal::kStreamFaultMask | hal::kFrameFaultMask)) == 0 &&
+                        std::isfinite(frame.header.stamp_s) && has_frame_stamp_ &&
+                        frame.header.stamp_s > last_frame_stamp_s_;
     if (usable) {
       int count = 0;
       if (have_width_) {

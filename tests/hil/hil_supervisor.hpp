@@ -35,7 +35,7 @@ namespace pliant::hil {
 struct SupervisorConfig {
   double close_speed_m_per_s = 0.004;
   double approach_speed_m_per_s = 0.05;
-  double approach_gap_m = 0.0015;       ///< approach ends this far outside the visible width
+  double approach_gap_m = 0.0015;  ///< approach ends this far outside the visible width
   double open_speed_m_per_s = 0.02;
   double open_margin_m = 0.002;
   double target_closure_fraction = 0.45;  ///< squeeze target: this fraction of the width, far past safe

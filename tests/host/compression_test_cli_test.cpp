@@ -44,10 +44,10 @@ TEST(cli_import, OneCsvBecomesTheOutputDirectory) {
 
 TEST(cli_import, SeveralCsvsGoToSubdirectoriesNamedAfterTheFiles) {
   TempDir dir;
-  const CommandResult r = run_pliant("import compression " + quoted(kEf10) + " " + quoted(kEf30) + " -o " +
-                                     quoted(dir.path().string()) +
-                                     " --contact bonded --poisson-ratio 0.45 --density 1040 --mesh-divisions 1,8,2 "
-                                     "--frame-interval 10 --source 'lab X' --license 'CC BY 4.0'");
+  const CommandResult r =
+      run_pliant("import compression " + quoted(kEf10) + " " + quoted(kEf30) + " -o " + quoted(dir.path().string()) +
+                 " --contact bonded --poisson-ratio 0.45 --density 1040 --mesh-divisions 1,8,2 "
+                 "--frame-interval 10 --source 'lab X' --license 'CC BY 4.0'");
   ASSERT_EQ(r.status, 0) << r.err;
   ASSERT_EQ(lines_of(r.out).size(), 2u) << r.out;
   for (const char* name : {"EF10_0T_B5", "EF30_0T_A5"}) {
@@ -76,7 +76,8 @@ TEST(cli_import, MalformedCsvExitsTwoNamingFileAndLineAndWritesNothing) {
   EXPECT_FALSE(fs::exists(out));
 
   // With several files, one bad file stops the run before anything is written.
-  const CommandResult several = run_pliant("import compression " + quoted(kEf10) + " " + quoted(bad) + " -o " + quoted(out));
+  const CommandResult several =
+      run_pliant("import compression " + quoted(kEf10) + " " + quoted(bad) + " -o " + quoted(out));
   expect_one_error_line(several, bad + ":10: ");
   EXPECT_FALSE(fs::exists(fs::path(out) / "EF10_0T_B5"));
 
@@ -109,15 +110,16 @@ TEST(cli_import, SameFileNameTwiceIsRefused) {
   fs::create_directories(dir / "b");
   fs::copy_file(kEf10, dir / "a/x.csv");
   fs::copy_file(kEf10, dir / "b/x.csv");
-  const CommandResult r =
-      run_pliant("import compression " + quoted(dir / "a/x.csv") + " " + quoted(dir / "b/x.csv") + " -o " + quoted(dir / "out"));
+  const CommandResult r = run_pliant("import compression " + quoted(dir / "a/x.csv") + " " + quoted(dir / "b/x.csv") +
+                                     " -o " + quoted(dir / "out"));
   expect_one_error_line(r, "two CSV files are named 'x'");
 }
 
 TEST(cli_import, RefusesNonEmptyDirectoryWithoutForce) {
   TempDir dir;
   write_text(dir / "notes.txt", "keep me\n");
-  const std::string args = "import compression " + quoted(kEf10) + " --max-strain 0.05 -o " + quoted(dir.path().string());
+  const std::string args =
+      "import compression " + quoted(kEf10) + " --max-strain 0.05 -o " + quoted(dir.path().string());
   const CommandResult refused = run_pliant(args);
   expect_one_error_line(refused, "--force");
   EXPECT_FALSE(fs::exists(dir / "recording.json"));

@@ -115,7 +115,8 @@ TEST(CylinderMesh, VolumeWithinOnePercentAtModerateResolutionAndConvergesMonoton
 }
 
 TEST(CylinderMesh, EveryTetrahedronHasPositiveVolume) {
-  for (const auto& d : {CylinderMeshDivisions{1, 8, 1}, CylinderMeshDivisions{2, 24, 5}, CylinderMeshDivisions{5, 40, 3}}) {
+  for (const auto& d :
+       {CylinderMeshDivisions{1, 8, 1}, CylinderMeshDivisions{2, 24, 5}, CylinderMeshDivisions{5, 40, 3}}) {
     const TetMesh m = cylinder_tet_mesh(kDiameter, kHeight, d);
     const double typical = mesh_volume(m) / m.tet_count();
     for (int t = 0; t < m.tet_count(); ++t) {

@@ -272,7 +272,8 @@ TEST(CompressionRecording, RefusesBadOptionsAndTestsThatDoNotCompress) {
   EXPECT_THROW(compression_test_recording(test, with([](O& o) { o.frame_count = kMaxCompressionFrames; })),
                std::invalid_argument);
   EXPECT_THROW(compression_test_recording(test, with([](O& o) { o.max_strain = 0.0; })), std::invalid_argument);
-  EXPECT_THROW(compression_test_recording(test, with([](O& o) { o.max_strain = std::nan(""); })), std::invalid_argument);
+  EXPECT_THROW(compression_test_recording(test, with([](O& o) { o.max_strain = std::nan(""); })),
+               std::invalid_argument);
   EXPECT_THROW(compression_test_recording(test, with([](O& o) { o.mesh.circumferential = 12; })),
                std::invalid_argument);
   // Past max_strain already in the first frame: a single frame is no recording.

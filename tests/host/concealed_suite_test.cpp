@@ -40,7 +40,8 @@ namespace fs = std::filesystem;
 
 fs::path suite_directory() {
   const char* override_dir = std::getenv("PLIANT_CONCEALED_SUITE_DIR");
-  return override_dir != nullptr && *override_dir != '\0' ? fs::path(override_dir) : fs::path(PLIANT_CONCEALED_SUITE_DIR);
+  return override_dir != nullptr && *override_dir != '\0' ? fs::path(override_dir)
+                                                          : fs::path(PLIANT_CONCEALED_SUITE_DIR);
 }
 
 const fs::path kSuite = suite_directory();
@@ -96,18 +97,17 @@ std::string format_number(double value, int precision) {
 std::string score_line(const std::string& name, const nlohmann::json& truth, const Diagnosis& d, double runtime_s) {
   std::ostringstream line;
   const double size = rms_over_noise(truth);
-  line << name << ": truth " << truth.value("effect", "?") << " (" << truth.value("scenario", "?")
-       << ", rms/noise " << (size < 0 ? std::string("-") : format_number(size, 1)) << ", noise "
-       << truth.value("noise_std", 0.0) << ")  found " << d.verdict << " / " << d.effect
-       << "  baseline rms " << d.baseline.rms << ", augmented rms " << d.augmented.rms << ", improvement "
-       << format_number(d.improvement, 3) << ", noise rms " << d.noise_rms << ", runtime "
-       << format_number(runtime_s, 1) << " s";
+  line << name << ": truth " << truth.value("effect", "?") << " (" << truth.value("scenario", "?") << ", rms/noise "
+       << (size < 0 ? std::string("-") : format_number(size, 1)) << ", noise " << truth.value("noise_std", 0.0)
+       << ")  found " << d.verdict << " / " << d.effect << "  baseline rms " << d.baseline.rms << ", augmented rms "
+       << d.augmented.rms << ", improvement " << format_number(d.improvement, 3) << ", noise rms " << d.noise_rms
+       << ", runtime " << format_number(runtime_s, 1) << " s";
   const std::vector<int> expected = truth_particles(truth);
   if (!expected.empty()) {
     const std::set<int> located(d.location.particles.begin(), d.location.particles.end());
     const auto hits = std::count_if(expected.begin(), expected.end(), [&](int id) { return located.count(id) > 0; });
-    line << "  location: " << hits << " of " << expected.size() << " truth particles among "
-         << located.size() << " located";
+    line << "  location: " << hits << " of " << expected.size() << " truth particles among " << located.size()
+         << " located";
   }
   return line.str();
 }

@@ -48,7 +48,8 @@ TEST(EffectCatalogue, EveryEffectVanishesAtItsNull) {
   const std::vector<Effect> effects = effect_catalogue(context);
   std::set<std::string> names;
   for (const Effect& effect : effects) names.insert(effect.name);
-  EXPECT_EQ(names, (std::set<std::string>{"plasticity", "viscosity", "friction", "gravity", "heterogeneity", "stiffening"}));
+  EXPECT_EQ(names,
+            (std::set<std::string>{"plasticity", "viscosity", "friction", "gravity", "heterogeneity", "stiffening"}));
 
   const double beta = 0.43;
   ModelSettings baseline;

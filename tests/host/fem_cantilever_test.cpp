@@ -104,13 +104,15 @@ TEST(Cantilever, RefinedIpcBarMatchesEulerBernoulli) {
     results.push_back(analyse(mesh, true));
     const Result& r = results.back();
     std::printf("%-16s %7d %6d | %12.6g %+7.2f%% | %10.6g %+7.2f%% | %6.2f\n",
-                (level == 0 ? std::string("bar-2523") : "bar-2523 x" + std::to_string(1 << (3 * level))).c_str(), r.tets, r.nodes, r.compliance,
-                100 * (r.compliance / compliance_eb - 1), r.f1, 100 * (r.f1 / f1_eb - 1), r.seconds);
+                (level == 0 ? std::string("bar-2523") : "bar-2523 x" + std::to_string(1 << (3 * level))).c_str(),
+                r.tets, r.nodes, r.compliance, 100 * (r.compliance / compliance_eb - 1), r.f1, 100 * (r.f1 / f1_eb - 1),
+                r.seconds);
     std::fflush(stdout);
   }
   // Converges towards beam theory from the stiff side, monotonically.
   for (std::size_t k = 1; k < results.size(); ++k) {
-    EXPECT_LT(std::abs(results[k].compliance / compliance_eb - 1), std::abs(results[k - 1].compliance / compliance_eb - 1));
+    EXPECT_LT(std::abs(results[k].compliance / compliance_eb - 1),
+              std::abs(results[k - 1].compliance / compliance_eb - 1));
     EXPECT_LT(std::abs(results[k].f1 / f1_eb - 1), std::abs(results[k - 1].f1 / f1_eb - 1));
   }
   // Within 3 % of Euler-Bernoulli at the finest level (twice refined, 161472 tetrahedra).

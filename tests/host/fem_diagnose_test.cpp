@@ -106,7 +106,6 @@ Recording compression_recording(const TetMesh& mesh, int frames, double dt, doub
   return r;
 }
 
-
 // The z force of a run of `recording` per frame (NaN where the run has none).
 std::vector<double> force_z(const Recording& recording, FemTimeMode mode, const FemRunSettings& settings) {
   FemRecordingSimulator simulator(recording, mode, 1);
@@ -142,8 +141,8 @@ void print(const std::string& label, const DiagnoseResult& r) {
   const Diagnosis& d = r.diagnosis;
   std::cout << "[ fem      ] " << label << ": " << d.verdict << " (" << d.effect << "), E "
             << d.baseline.parameters.at("youngs_modulus") << " Pa, force rms " << d.baseline.force_rms << " -> "
-            << d.augmented.force_rms << " N (noise " << d.force_noise_rms << "), improvement " << d.improvement
-            << ", " << r.runtime_s << " s\n  " << d.explanation << "\n";
+            << d.augmented.force_rms << " N (noise " << d.force_noise_rms << "), improvement " << d.improvement << ", "
+            << r.runtime_s << " s\n  " << d.explanation << "\n";
   for (const Candidate& c : d.candidates) {
     std::cout << "    " << c.effect << ": force rms " << c.force_rms << ", bic " << c.bic;
     for (const auto& [name, value] : c.parameters) std::cout << ", " << name << " " << value;
@@ -290,7 +289,6 @@ TEST(FemDiagnose, ForceOnlyDiagnosisIsWrittenWithNullPositionRms) {
   EXPECT_NE(html.find("data-note=\"force-only\""), std::string::npos);  // no maps of constrained nodes
 }
 
-
 // A small bonded compression generated with the fitted model itself (same mesh, same solver),
 // force noise 0.2 % of the peak: the diagnosis must give the generator's parameters back.
 struct SelfGenerated {
@@ -351,9 +349,9 @@ TEST(FemDiagnose, ObservedFreeNodesAreComparedAndAStiffRegionIsNamedHeterogeneit
     std::vector<double> force(at(frames));
     for (int k = 0; k < frames; ++k) force[at(k)] = run.force[at(k) * 3 + 2];
     const double sigma = 2e-5;
-    const Recording recording = compression_recording(mesh, frames, dt, 0.3, false,
-                                                      with_noise(force, 0.002 * peak_magnitude(force), 31),
-                                                      with_noise(run.positions, sigma, 32));
+    const Recording recording =
+        compression_recording(mesh, frames, dt, 0.3, false, with_noise(force, 0.002 * peak_magnitude(force), 31),
+                              with_noise(run.positions, sigma, 32));
     const DiagnoseResult r = diagnose_fem(recording);
     print(stiff_region ? "observed, stiff region" : "observed, homogeneous", r);
     const Diagnosis& d = r.diagnosis;
@@ -494,8 +492,8 @@ Synthetic synthetic_compression(double stiffening, double latency_s, double nois
   out.recording = compression_recording(coarse, frames, dt, peak_strain, unload,
                                         with_noise(force, noise_fraction * out.peak_force, seed));
   std::cout << "[ fem      ] generator: refined mesh " << fine.point_count() << " nodes, recording mesh "
-            << coarse.point_count() << " nodes; E " << kYoungs << " Pa on the refined mesh is "
-            << out.mesh_youngs << " Pa on the recording's\n";
+            << coarse.point_count() << " nodes; E " << kYoungs << " Pa on the refined mesh is " << out.mesh_youngs
+            << " Pa on the recording's\n";
   return out;
 }
 

@@ -68,7 +68,8 @@ struct Decay {
   double energy_drift = 0;
 };
 
-Decay run_mode(Cantilever& c, FemSolver& solver, int k, double omega_dt, double periods, const fem::FemStepOptions& options) {
+Decay run_mode(Cantilever& c, FemSolver& solver, int k, double omega_dt, double periods,
+               const fem::FemStepOptions& options) {
   const FemModel& model = c.model;
   const double omega = c.modes.omega_rad_s[k];
   const Eigen::VectorXd phi = c.modes.shape.col(k);
@@ -131,8 +132,8 @@ TEST(FemDynamics, BackwardEulerDampsAtOmegaDtOverTwo) {
     // Exact for backward Euler on an undamped mode: |z| = 1 / sqrt(1 + (omega dt)^2) per step.
     const double sigma_exact = std::log(1 + omega_dt * omega_dt) / (2 * dt);
     const double zeta = d.sigma / omega;
-    std::printf("backward Euler, omega dt = %.2f: zeta %.5f, omega dt / 2 = %.5f, exact discrete %.5f\n", omega_dt, zeta,
-                omega_dt / 2, sigma_exact / omega);
+    std::printf("backward Euler, omega dt = %.2f: zeta %.5f, omega dt / 2 = %.5f, exact discrete %.5f\n", omega_dt,
+                zeta, omega_dt / 2, sigma_exact / omega);
     EXPECT_NEAR(d.sigma / sigma_exact, 1.0, 0.02);
     EXPECT_NEAR(zeta / (omega_dt / 2), 1.0, 0.03);
   }
@@ -155,8 +156,8 @@ TEST(FemDynamics, RayleighDampingMatchesModalFormula) {
     const double omega = c.modes.omega_rad_s[k];
     const double expected = m.rayleigh_alpha / (2 * omega) + m.rayleigh_beta * omega / 2;
     const Decay d = run_mode(c, solver, k, 0.05, 6, options);
-    std::printf("Rayleigh, mode %d (%.3f Hz): zeta %.5f, alpha/(2w) + beta w/2 = %.5f\n", k + 1, c.modes.frequency_hz[k],
-                d.sigma / omega, expected);
+    std::printf("Rayleigh, mode %d (%.3f Hz): zeta %.5f, alpha/(2w) + beta w/2 = %.5f\n", k + 1,
+                c.modes.frequency_hz[k], d.sigma / omega, expected);
     EXPECT_NEAR(d.sigma / omega / expected, 1.0, 0.03) << "mode " << k + 1;
   }
 }
@@ -203,7 +204,8 @@ TEST(FemDynamics, FreeBodyConservesLinearMomentum) {
     }
     auto momentum = [&]() {
       Eigen::Vector3d p = Eigen::Vector3d::Zero();
-      for (int i = 0; i < model.node_count(); ++i) p += model.lumped_mass_kg()[i] * state.velocity_m_s.segment<3>(3 * i);
+      for (int i = 0; i < model.node_count(); ++i)
+        p += model.lumped_mass_kg()[i] * state.velocity_m_s.segment<3>(3 * i);
       return p;
     };
     const Eigen::Vector3d p0 = momentum();

@@ -66,7 +66,7 @@ double relative_error(double value, double truth) { return std::abs(value - trut
 
 // Root mean square over the observed nodes of frames 1.. of a - b (positions, m).
 [[maybe_unused]] double rms_difference(const FemRecordingProblem& problem, const std::vector<Eigen::VectorXd>& a,
-                      const std::vector<Eigen::VectorXd>& b) {
+                                       const std::vector<Eigen::VectorXd>& b) {
   double sum = 0;
   int count = 0;
   for (std::size_t f = 1; f < problem.frames.size(); ++f) {
@@ -154,8 +154,9 @@ TEST_F(FemEstimateDynamic, SimulationAtTheTruthReproducesTheData) {
   options.substeps = 4;
   const auto positions = simulate_trajectory(problem, uniform_->element_youngs_modulus_pa, kAlpha, kBeta, options);
   ASSERT_EQ(positions.size(), problem.frames.size());
-  std::vector<Eigen::VectorXd> rest(problem.frames.size(), Eigen::Map<const Eigen::VectorXd>(
-                                                               problem.mesh.points.data(), problem.mesh.point_count() * 3));
+  std::vector<Eigen::VectorXd> rest(
+      problem.frames.size(),
+      Eigen::Map<const Eigen::VectorXd>(problem.mesh.points.data(), problem.mesh.point_count() * 3));
   const double error = rms_difference(problem, positions, observed(problem));
   const double motion = rms_difference(problem, observed(problem), rest);
   // Not the generator's discretisation (no inverse crime), but close: < 0.5 % of the motion.
@@ -163,9 +164,9 @@ TEST_F(FemEstimateDynamic, SimulationAtTheTruthReproducesTheData) {
   EXPECT_LT(error, 5e-3 * motion);
   // Twice the substeps: Newmark's error falls about fourfold (second order).
   options.substeps = 8;
-  const double finer = rms_difference(problem, simulate_trajectory(problem, uniform_->element_youngs_modulus_pa,
-                                                                   kAlpha, kBeta, options),
-                                      observed(problem));
+  const double finer =
+      rms_difference(problem, simulate_trajectory(problem, uniform_->element_youngs_modulus_pa, kAlpha, kBeta, options),
+                     observed(problem));
   EXPECT_LT(finer, error / 3);
   EXPECT_GT(finer, error / 6);
 }
@@ -423,8 +424,8 @@ TEST_F(FemEstimateDynamic, MaterialMapWithTwoControlPointsAndDamping) {
   TrajectoryEstimateOptions options;
   options.control_points_m = two_points_->control_points_m;
   const TrajectoryEstimate fit = estimate_trajectory_parameters(problem, options);
-  ASSERT_EQ(fit.names, (std::vector<std::string>{"youngs_modulus[0]", "youngs_modulus[1]", "rayleigh_alpha",
-                                                 "rayleigh_beta"}));
+  ASSERT_EQ(fit.names,
+            (std::vector<std::string>{"youngs_modulus[0]", "youngs_modulus[1]", "rayleigh_alpha", "rayleigh_beta"}));
   EXPECT_TRUE(fit.converged) << fit.message;
   EXPECT_LT(relative_error(fit.control_youngs_modulus_pa[0], 3e5), 0.01);
   EXPECT_LT(relative_error(fit.control_youngs_modulus_pa[1], 1.2e6), 0.02);

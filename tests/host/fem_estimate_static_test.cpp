@@ -65,8 +65,8 @@ TEST(StepeScenario, RecordingRoundTripsWithTruthBeside) {
   const StepeScenario s = make_stepe_scenario(o);
   const Recording& r = s.recording;
   EXPECT_EQ(r.particle_count, 7 * 5 * 4);
-  EXPECT_EQ(r.fixed.size(), 35u);                  // the bottom face
-  EXPECT_EQ(r.wrench_applied_to.size(), 9u);       // 3 x 3 footprint
+  EXPECT_EQ(r.fixed.size(), 35u);             // the bottom face
+  EXPECT_EQ(r.wrench_applied_to.size(), 9u);  // 3 x 3 footprint
   EXPECT_EQ(r.frame_count(), 3);
   EXPECT_TRUE(r.driven.empty());
   EXPECT_EQ(r.material.count("youngs_modulus"), 0u);  // the unknown is in the truth only
@@ -294,9 +294,7 @@ struct TableIIIRow {
   double tilt_deg;
 };
 
-void PrintTo(const TableIIIRow& row, std::ostream* os) {
-  *os << row.name << " " << row.depth_m * 100 << " cm";
-}
+void PrintTo(const TableIIIRow& row, std::ostream* os) { *os << row.name << " " << row.depth_m * 100 << " cm"; }
 
 class StepeTableIII : public ::testing::TestWithParam<TableIIIRow> {};
 
@@ -319,10 +317,11 @@ TEST_P(StepeTableIII, RemoteForceWithinTenPercentOfTheMeasuredForce) {
   o.frames.first_time_s = 2.0;  // frames 2 and 3, at full depth
   const ContactForceEstimate e = estimate_contact_force(fem_problem_from_recording(s.recording), kFoamPa, o);
   std::cout << format_frame_table(e);
-  std::printf("[ table III] %-10s depth %.0f cm  f_GT %7.1f N  f_est %7.1f N  projected %7.1f N  delta_f %+6.1f N "
-              "(%+.1f %%)  wall %.1f s  cpu %.1f s\n",
-              row.name, row.depth_m * 100, e.mean_measured_norm_n, e.mean_estimated_norm_n, e.mean_projected_n,
-              e.mean_difference_n, 100 * e.mean_difference_n / e.mean_measured_norm_n, e.wall_s, e.cpu_s);
+  std::printf(
+      "[ table III] %-10s depth %.0f cm  f_GT %7.1f N  f_est %7.1f N  projected %7.1f N  delta_f %+6.1f N "
+      "(%+.1f %%)  wall %.1f s  cpu %.1f s\n",
+      row.name, row.depth_m * 100, e.mean_measured_norm_n, e.mean_estimated_norm_n, e.mean_projected_n,
+      e.mean_difference_n, 100 * e.mean_difference_n / e.mean_measured_norm_n, e.wall_s, e.cpu_s);
   EXPECT_TRUE(e.converged);
   EXPECT_EQ(e.compared_frames, 2);
   EXPECT_LT(std::abs(e.mean_difference_n), 0.10 * e.mean_measured_norm_n);

@@ -38,9 +38,7 @@ void write_all(const std::string& path, const std::string& text) {
 
 // Signed volume of tetrahedron t, computed independently of the library.
 double volume_of(const TetMesh& mesh, std::size_t t) {
-  const auto p = [&](std::size_t k) {
-    return &mesh.points[3 * static_cast<std::size_t>(mesh.tetrahedra[4 * t + k])];
-  };
+  const auto p = [&](std::size_t k) { return &mesh.points[3 * static_cast<std::size_t>(mesh.tetrahedra[4 * t + k])]; };
   const double* a = p(0);
   const double* b = p(1);
   const double* c = p(2);
@@ -79,9 +77,9 @@ double boundary_volume(const TetMesh& mesh, std::size_t& boundary_faces) {
     const double* a = &mesh.points[3 * static_cast<std::size_t>(f[0])];
     const double* b = &mesh.points[3 * static_cast<std::size_t>(f[1])];
     const double* c = &mesh.points[3 * static_cast<std::size_t>(f[2])];
-    volume += (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
-               a[2] * (b[0] * c[1] - b[1] * c[0])) /
-              6.0;
+    volume +=
+        (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0])) /
+        6.0;
   }
   return volume;
 }
@@ -140,9 +138,8 @@ TEST_P(IpcMesh, ReadsCountsOrientationAndClosedBoundary) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Files, IpcMesh,
-                         ::testing::Values("bar-6.msh", "bar-186.msh", "bar-651.msh",
-                                           "bar-2523.msh", "cube.msh", "tet.msh",
-                                           "sphere1K.msh"),
+                         ::testing::Values("bar-6.msh", "bar-186.msh", "bar-651.msh", "bar-2523.msh", "cube.msh",
+                                           "tet.msh", "sphere1K.msh"),
                          [](const ::testing::TestParamInfo<const char*>& param_info) {
                            std::string name = param_info.param;
                            name = name.substr(0, name.find('.'));
@@ -202,8 +199,7 @@ TEST(Msh41, SparseTagsBlocksSkippedElementsAndOrientation) {
   EXPECT_EQ(report.skipped_elements, 4);
   EXPECT_EQ(report.unused_points, 0);
   ASSERT_EQ(report.warnings.size(), 1u);
-  EXPECT_NE(report.warnings[0].find("sparse.msh: 1 tetrahedra were negatively oriented"),
-            std::string::npos)
+  EXPECT_NE(report.warnings[0].find("sparse.msh: 1 tetrahedra were negatively oriented"), std::string::npos)
       << report.warnings[0];
   for (std::size_t t = 0; t < 2; ++t) EXPECT_GT(volume_of(mesh, t), 0.0);
 }
@@ -448,8 +444,7 @@ TEST(ReadTetMesh, VtkParseErrorsBecomeMeshError) {
   test_support::TempDir dir("pliant_fem_mesh_");
   write_all(dir / "bad.vtk", "# vtk DataFile Version 3.0\nx\nBINARY\n");
   const std::string message = error_of([&] { read_tet_mesh(dir / "bad.vtk"); });
-  EXPECT_NE(message.find("bad.vtk:3: binary VTK files are not supported"), std::string::npos)
-      << message;
+  EXPECT_NE(message.find("bad.vtk:3: binary VTK files are not supported"), std::string::npos) << message;
 }
 
 TEST(ReadTetMesh, UppercaseExtensions) {

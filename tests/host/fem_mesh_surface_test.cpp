@@ -25,13 +25,10 @@ double six_volume(const double* a, const double* b, const double* c, const doubl
   const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
   const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
   const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
-  return u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
-         u[2] * (v[0] * w[1] - v[1] * w[0]);
+  return u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) + u[2] * (v[0] * w[1] - v[1] * w[0]);
 }
 
-const double* pt(const std::vector<double>& points, int i) {
-  return &points[3 * static_cast<std::size_t>(i)];
-}
+const double* pt(const std::vector<double>& points, int i) { return &points[3 * static_cast<std::size_t>(i)]; }
 
 // Independent oracle: enclosed volume of a closed, outward-wound triangle surface.
 double enclosed_volume(const TriangleSurface& s) {
@@ -62,9 +59,9 @@ MeshStats stats_of(const TetMesh& mesh) {
   for (std::size_t t = 0; t < mesh.tetrahedra.size(); t += 4) {
     const int* tet = &mesh.tetrahedra[t];
     for (int k = 0; k < 4; ++k) used[static_cast<std::size_t>(tet[k])] = 1;
-    const double v = six_volume(pt(mesh.points, tet[0]), pt(mesh.points, tet[1]),
-                                pt(mesh.points, tet[2]), pt(mesh.points, tet[3])) /
-                     6.0;
+    const double v =
+        six_volume(pt(mesh.points, tet[0]), pt(mesh.points, tet[1]), pt(mesh.points, tet[2]), pt(mesh.points, tet[3])) /
+        6.0;
     s.volume += v;
     s.max_tet_volume = std::max(s.max_tet_volume, v);
     s.min_tet_volume = std::min(s.min_tet_volume, v);
@@ -81,9 +78,7 @@ MeshStats stats_of(const TetMesh& mesh) {
     if (entry.second.size() != 1) continue;
     ++s.boundary_faces;
     const auto& f = entry.second.front();
-    s.boundary_volume += six_volume(origin, pt(mesh.points, f[0]), pt(mesh.points, f[1]),
-                                    pt(mesh.points, f[2])) /
-                         6.0;
+    s.boundary_volume += six_volume(origin, pt(mesh.points, f[0]), pt(mesh.points, f[1]), pt(mesh.points, f[2])) / 6.0;
   }
   for (const char u : used) s.unused_points += u == 0 ? 1 : 0;
   return s;
@@ -98,8 +93,7 @@ TriangleSurface box(double x0, double y0, double z0, double dx, double dy, doubl
     s.points.push_back(z0 + ((k & 4) ? dz : 0.0));
   }
   // Quads (outward), split into two triangles each.
-  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
-                           {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
   for (const auto& q : quads) {
     s.triangles.insert(s.triangles.end(), {q[0], q[1], q[2], q[0], q[2], q[3]});
   }
@@ -109,9 +103,8 @@ TriangleSurface box(double x0, double y0, double z0, double dx, double dy, doubl
 // Icosahedron subdivided `levels` times, projected on a sphere of `radius` around `center`.
 TriangleSurface icosphere(int levels, double radius, const double center[3]) {
   const double g = (1.0 + std::sqrt(5.0)) / 2.0;
-  std::vector<std::array<double, 3>> v = {{-1, g, 0}, {1, g, 0},  {-1, -g, 0}, {1, -g, 0},
-                                          {0, -1, g}, {0, 1, g},  {0, -1, -g}, {0, 1, -g},
-                                          {g, 0, -1}, {g, 0, 1},  {-g, 0, -1}, {-g, 0, 1}};
+  std::vector<std::array<double, 3>> v = {{-1, g, 0},  {1, g, 0},  {-1, -g, 0}, {1, -g, 0}, {0, -1, g},  {0, 1, g},
+                                          {0, -1, -g}, {0, 1, -g}, {g, 0, -1},  {g, 0, 1},  {-g, 0, -1}, {-g, 0, 1}};
   std::vector<std::array<int, 3>> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
                                        {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
                                        {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
@@ -202,15 +195,13 @@ void put(std::string& out, T value, bool big_endian) {
 }
 
 std::string cube_ply_binary(bool big_endian) {
-  std::string out = std::string("ply\nformat ") +
-                    (big_endian ? "binary_big_endian" : "binary_little_endian") +
+  std::string out = std::string("ply\nformat ") + (big_endian ? "binary_big_endian" : "binary_little_endian") +
                     " 1.0\nelement vertex 8\nproperty double x\nproperty double y\n"
                     "property double z\nelement face 6\n"
                     "property list uchar uint vertex_index\nend_header\n";
   const TriangleSurface cube = box(0, 0, 0, 1, 1, 1);
   for (const double v : cube.points) put<double>(out, v, big_endian);
-  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
-                           {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
   for (const auto& q : quads) {
     put<std::uint8_t>(out, 4, big_endian);
     for (const int i : q) put<std::uint32_t>(out, static_cast<std::uint32_t>(i), big_endian);
@@ -251,8 +242,7 @@ std::string cube_stl_ascii() {
     out += "  facet normal 0 0 0\n    outer loop\n";
     for (std::size_t k = 0; k < 3; ++k) {
       const double* p = pt(cube.points, cube.triangles[t + k]);
-      out += "      vertex " + std::to_string(p[0]) + " " + std::to_string(p[1]) + " " +
-             std::to_string(p[2]) + "\n";
+      out += "      vertex " + std::to_string(p[0]) + " " + std::to_string(p[1]) + " " + std::to_string(p[2]) + "\n";
     }
     out += "    endloop\n  endfacet\n";
   }
@@ -306,7 +296,7 @@ TEST(Merge, ToleranceIsRelativeToTheBoundingBox) {
 
 TEST(Merge, CollapsedTrianglesAreDroppedAndCounted) {
   TriangleSurface s = box(0, 0, 0, 1, 1, 1);
-  s.points.insert(s.points.end(), {0, 0, 0});      // point 8 == point 0
+  s.points.insert(s.points.end(), {0, 0, 0});        // point 8 == point 0
   s.triangles.insert(s.triangles.end(), {0, 8, 1});  // collapses after merging
   const SurfaceMergeResult merged = merge_duplicate_vertices(s, "s");
   EXPECT_EQ(merged.triangles_dropped, 1);
@@ -338,9 +328,9 @@ TEST(TetgenSwitches, BuiltFromOptions) {
   options.min_dihedral_angle_deg = 0.0;
   options.max_tet_volume = 0.0;
   EXPECT_EQ(tetgen_switches(options), "pzY");
-  for (const auto& bad : {std::array<double, 3>{0.5, 0, 0}, std::array<double, 3>{2, 80, 0},
-                          std::array<double, 3>{0, 10, 0}, std::array<double, 3>{2, 0, -1},
-                          std::array<double, 3>{2, 0, std::nan("")}}) {
+  for (const auto& bad :
+       {std::array<double, 3>{0.5, 0, 0}, std::array<double, 3>{2, 80, 0}, std::array<double, 3>{0, 10, 0},
+        std::array<double, 3>{2, 0, -1}, std::array<double, 3>{2, 0, std::nan("")}}) {
     TetrahedralizeOptions o;
     o.max_radius_edge_ratio = bad[0];
     o.min_dihedral_angle_deg = bad[1];
@@ -389,8 +379,7 @@ TEST(Tetrahedralize, IcosphereIsConsistentAndBounded) {
     double volume;
     bool preserve;
   };
-  for (const Run& run : {Run{2.0, 0.0, 0.0, false}, Run{1.5, 10.0, bound, false},
-                         Run{1.4, 0.0, bound, true}}) {
+  for (const Run& run : {Run{2.0, 0.0, 0.0, false}, Run{1.5, 10.0, bound, false}, Run{1.4, 0.0, bound, true}}) {
     TetrahedralizeOptions options;
     options.max_radius_edge_ratio = run.ratio;
     options.min_dihedral_angle_deg = run.angle;
@@ -455,18 +444,20 @@ TEST(Tetrahedralize, TimeoutStopsRunawayRefinement) {
 TEST(ReadTetMesh, SurfaceFilesAreTetrahedralized) {
   test_support::TempDir dir("pliant_fem_mesh_");
   const std::pair<std::string, std::string> files[] = {
-      {"cube.stl", cube_stl_ascii()},      {"cube_binary.STL", cube_stl_binary()},
-      {"cube.ply", cube_ply_ascii()},      {"cube_be.ply", cube_ply_binary(true)},
-      {"cube.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
-                   "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n"}};
+      {"cube.stl", cube_stl_ascii()},
+      {"cube_binary.STL", cube_stl_binary()},
+      {"cube.ply", cube_ply_ascii()},
+      {"cube_be.ply", cube_ply_binary(true)},
+      {"cube.obj",
+       "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+       "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n"}};
   for (const auto& file : files) {
     write_text(dir / file.first, file.second);
     MeshReadReport report;
     const TetMesh mesh = read_tet_mesh(dir / file.first, &report);
     EXPECT_NEAR(tet_mesh_volume(mesh), 1.0, 1e-9) << file.first;
     EXPECT_GT(stats_of(mesh).min_tet_volume, 0.0) << file.first;
-    const bool stl = file.first.find(".stl") != std::string::npos ||
-                     file.first.find(".STL") != std::string::npos;
+    const bool stl = file.first.find(".stl") != std::string::npos || file.first.find(".STL") != std::string::npos;
     EXPECT_EQ(report.warnings.size(), stl ? 1u : 0u) << file.first;
   }
   std::vector<std::string> warnings;

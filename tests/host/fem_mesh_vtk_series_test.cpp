@@ -44,8 +44,8 @@ struct XmlElement {
 };
 
 bool is_name_char(char c) {
-  return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' ||
-         c == '-' || c == '.' || c == ':';
+  return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-' ||
+         c == '.' || c == ':';
 }
 
 class XmlReader {
@@ -225,8 +225,7 @@ TEST(VtkSeries, PvdAndVtuFramesAreWellFormedAndExact) {
     ASSERT_NE(grid, nullptr);
     const XmlElement* field = child(*grid, "FieldData");
     ASSERT_NE(field, nullptr);
-    EXPECT_EQ(numbers(array_named(*field, "TimeValue")->text),
-              std::vector<double>{s.frames[f].time_s});
+    EXPECT_EQ(numbers(array_named(*field, "TimeValue")->text), std::vector<double>{s.frames[f].time_s});
     const XmlElement* piece = child(*grid, "Piece");
     ASSERT_NE(piece, nullptr);
     EXPECT_EQ(piece->attributes.at("NumberOfPoints"), "8");
@@ -238,8 +237,7 @@ TEST(VtkSeries, PvdAndVtuFramesAreWellFormedAndExact) {
     ASSERT_NE(cells, nullptr);
     std::vector<double> tets(s.mesh.tetrahedra.begin(), s.mesh.tetrahedra.end());
     EXPECT_EQ(numbers(array_named(*cells, "connectivity")->text), tets);
-    EXPECT_EQ(numbers(array_named(*cells, "offsets")->text),
-              (std::vector<double>{4, 8, 12, 16, 20, 24}));
+    EXPECT_EQ(numbers(array_named(*cells, "offsets")->text), (std::vector<double>{4, 8, 12, 16, 20, 24}));
     EXPECT_EQ(numbers(array_named(*cells, "types")->text), std::vector<double>(6, 10.0));
     const XmlElement* point_data = child(*piece, "PointData");
     ASSERT_NE(point_data, nullptr);
@@ -253,8 +251,7 @@ TEST(VtkSeries, PvdAndVtuFramesAreWellFormedAndExact) {
     const XmlElement* cell_data = child(*piece, "CellData");
     ASSERT_NE(cell_data, nullptr);
     EXPECT_EQ(numbers(array_named(*cell_data, "youngs_modulus")->text), s.mesh.youngs_modulus);
-    EXPECT_EQ(numbers(array_named(*cell_data, "von_mises_pa")->text),
-              s.frames[f].cell_scalars[0].values);
+    EXPECT_EQ(numbers(array_named(*cell_data, "von_mises_pa")->text), s.frames[f].cell_scalars[0].values);
   }
 }
 
@@ -281,8 +278,7 @@ TEST(VtkSeries, LegacyFramesReadBackWithTheRecordingReader) {
   }
   // The point vectors are 3-component SCALARS after POINT_DATA.
   const std::string text = read_all(dir / "bar-6.run_000001.vtk");
-  EXPECT_NE(text.find("POINT_DATA 8\nSCALARS displacement double 3\nLOOKUP_TABLE default\n"),
-            std::string::npos);
+  EXPECT_NE(text.find("POINT_DATA 8\nSCALARS displacement double 3\nLOOKUP_TABLE default\n"), std::string::npos);
   EXPECT_NE(text.find("SCALARS von_mises_pa double 1\n"), std::string::npos);
 }
 

@@ -58,7 +58,8 @@ Eigen::VectorXd deformed(const FemModel& model, double jitter, unsigned seed) {
   Eigen::VectorXd x = model.rest_position_m();
   for (int i = 0; i < model.node_count(); ++i) {
     const Eigen::Vector3d p = x.segment<3>(3 * i);
-    x.segment<3>(3 * i) = rotation(0.05 * p.x(), Eigen::Vector3d::UnitX()) * p + Eigen::Vector3d(0, 0, 0.02 * p.x() * p.x());
+    x.segment<3>(3 * i) =
+        rotation(0.05 * p.x(), Eigen::Vector3d::UnitX()) * p + Eigen::Vector3d(0, 0, 0.02 * p.x() * p.x());
     for (int d = 0; d < 3; ++d) x[3 * i + d] += jitter * u(rng);
   }
   return x;
@@ -147,7 +148,11 @@ TEST(FemModel, VolumesAndLumpedMass) {
     EXPECT_LT((b.rowwise().sum()).norm(), 1e-12);
     Eigen::Matrix3d grad = Eigen::Matrix3d::Zero();
     const Eigen::Matrix3d a = (Eigen::Matrix3d() << 1, 2, 3, 4, 5, 6, 7, 8, 10).finished();
-    for (int c = 0; c < 4; ++c) grad += a * model.rest_position_m().segment<3>(3 * model.elements()[static_cast<std::size_t>(e)][static_cast<std::size_t>(c)]) * b.col(c).transpose();
+    for (int c = 0; c < 4; ++c)
+      grad += a *
+              model.rest_position_m().segment<3>(
+                  3 * model.elements()[static_cast<std::size_t>(e)][static_cast<std::size_t>(c)]) *
+              b.col(c).transpose();
     EXPECT_LT((grad - a).norm(), 1e-12);
   }
 }
@@ -263,7 +268,8 @@ TEST(CorotationalForce, RotationInvariance) {
   ASSERT_GT(energy, 0);
   const Eigen::Vector3d t(3.0, -7.0, 0.5);
   for (double degrees : {30.0, 89.0, 91.0, 135.0, 180.0, 250.0, 359.0}) {
-    for (const Eigen::Vector3d& axis : {Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(1, -2, 0.5), Eigen::Vector3d(-1, 1, 1)}) {
+    for (const Eigen::Vector3d& axis :
+         {Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(1, -2, 0.5), Eigen::Vector3d(-1, 1, 1)}) {
       const Eigen::Matrix3d q = rotation(degrees * kPi / 180, axis);
       Eigen::VectorXd fq;
       fem::internal_force(model, transform(x, q, t), fq);
@@ -341,7 +347,8 @@ TEST(StiffnessMatrix, IsForceDerivativeAtRestAndScalesWithPerElementModulus) {
     const auto& n = model.elements()[static_cast<std::size_t>(e)];
     for (int a = 0; a < 4; ++a) {
       for (int b = 0; b < 4; ++b) {
-        sum.block<3, 3>(3 * n[static_cast<std::size_t>(a)], 3 * n[static_cast<std::size_t>(b)]) += ke.block<3, 3>(3 * a, 3 * b);
+        sum.block<3, 3>(3 * n[static_cast<std::size_t>(a)], 3 * n[static_cast<std::size_t>(b)]) +=
+            ke.block<3, 3>(3 * a, 3 * b);
       }
     }
   }
@@ -362,14 +369,16 @@ FaceCensus face_census(const TetMesh& mesh) {
   for (int e = 0; e < mesh.tet_count(); ++e) {
     for (const auto& face : kFaces) {
       std::array<int, 3> key{};
-      for (int k = 0; k < 3; ++k) key[static_cast<std::size_t>(k)] = mesh.tetrahedra[static_cast<std::size_t>(4 * e + face[k])];
+      for (int k = 0; k < 3; ++k)
+        key[static_cast<std::size_t>(k)] = mesh.tetrahedra[static_cast<std::size_t>(4 * e + face[k])];
       std::sort(key.begin(), key.end());
       ++faces[key];
     }
   }
   FaceCensus census;
   auto point = [&](int i) {
-    return Eigen::Vector3d(mesh.points[static_cast<std::size_t>(3 * i)], mesh.points[static_cast<std::size_t>(3 * i + 1)],
+    return Eigen::Vector3d(mesh.points[static_cast<std::size_t>(3 * i)],
+                           mesh.points[static_cast<std::size_t>(3 * i + 1)],
                            mesh.points[static_cast<std::size_t>(3 * i + 2)]);
   };
   for (const auto& [key, count] : faces) {
@@ -410,7 +419,8 @@ TEST(BoxMesh, ConformingPositiveAndSymmetric) {
   }
   for (int e = 0; e < box.tet_count(); ++e) {
     std::array<int, 4> t{};
-    for (int a = 0; a < 4; ++a) t[static_cast<std::size_t>(a)] = mirror(box.tetrahedra[static_cast<std::size_t>(4 * e + a)]);
+    for (int a = 0; a < 4; ++a)
+      t[static_cast<std::size_t>(a)] = mirror(box.tetrahedra[static_cast<std::size_t>(4 * e + a)]);
     std::sort(t.begin(), t.end());
     EXPECT_EQ(tets.count(t), 1u);
   }

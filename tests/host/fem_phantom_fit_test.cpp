@@ -35,8 +35,7 @@ struct Specimen {
   const char* material;  // key in hyperelastic_parameters.json
   const char* recording;
 };
-constexpr Specimen kSpecimens[] = {
-    {"EF10_0T", "EF10_0T_B5"}, {"EF30_0T", "EF30_0T_A5"}, {"EF50_0T", "EF50_0T_A4"}};
+constexpr Specimen kSpecimens[] = {{"EF10_0T", "EF10_0T_B5"}, {"EF30_0T", "EF30_0T_A5"}, {"EF50_0T", "EF50_0T_A4"}};
 
 double reference_youngs_modulus_pa(const std::string& material) {
   std::ifstream in(kDir + "/source/hyperelastic_parameters.json");

@@ -47,7 +47,8 @@ Eigen::VectorXd points_of(const TetMesh& mesh) {
 
 double max_node_distance(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   double worst = 0;
-  for (Eigen::Index i = 0; i < a.size() / 3; ++i) worst = std::max(worst, (a.segment<3>(3 * i) - b.segment<3>(3 * i)).norm());
+  for (Eigen::Index i = 0; i < a.size() / 3; ++i)
+    worst = std::max(worst, (a.segment<3>(3 * i) - b.segment<3>(3 * i)).norm());
   return worst;
 }
 
@@ -110,9 +111,9 @@ void print_quality(const char* shape, const RestShapeResult& r, const Eigen::Vec
       "(initial %.3g N)\n"
       "             mean |dX| %.3g m, max |dX| %.3g m; forward check mean |dx_s| %.3g m, max %.3g m; "
       "normalized by length: %.3g, %.3g\n",
-      shape, r.max_sag_m, 100.0 * r.max_sag_m / kLength, r.iterations, r.load_steps, r.residual_n,
-      r.initial_residual_n, d_rest, max_node_distance(r.rest_position_m, true_rest), r.forward_check_mean_error_m,
-      r.forward_check_error_m, d_rest / kLength, r.forward_check_mean_error_m / kLength);
+      shape, r.max_sag_m, 100.0 * r.max_sag_m / kLength, r.iterations, r.load_steps, r.residual_n, r.initial_residual_n,
+      d_rest, max_node_distance(r.rest_position_m, true_rest), r.forward_check_mean_error_m, r.forward_check_error_m,
+      d_rest / kLength, r.forward_check_mean_error_m / kLength);
   (void)observed;
 }
 
@@ -214,7 +215,8 @@ TEST(FemRestShape, HangingColumnMatchesAnalyticRestLength) {
               exact, first_order);
   EXPECT_NEAR(rest_length, exact, 1e-3 * (kLength - exact));
   // The first-order formula misses 2 c^2 L^3 (about 10 % of the elongation here).
-  EXPECT_NEAR(rest_length - first_order, 2 * c * c * kLength * kLength * kLength, 0.2 * 2 * c * c * std::pow(kLength, 3));
+  EXPECT_NEAR(rest_length - first_order, 2 * c * c * kLength * kLength * kLength,
+              0.2 * 2 * c * c * std::pow(kLength, 3));
 
   // 0.5 % elongation: the first-order formula is good to about 1 % of the elongation.
   const double small = estimated_column_rest_length(196200, &c);
@@ -290,10 +292,10 @@ TEST(FemRestShape, NoisyObservationConvergesAndErrorScalesWithNoise) {
     EXPECT_LE(r.iterations, 10);
     EXPECT_LT(r.forward_check_error_m, 1e-6 * kLength);  // reproduces the noisy shape
     errors[k] = max_node_distance(r.rest_position_m, c.rest);
-    std::printf("[rest shape] noise sigma %.1e m (%.0e of length): max |dX| %.3g m, mean |dX| %.3g m, "
-                "%d iterations\n",
-                sigmas[k], sigmas[k] / kLength, errors[k], mean_node_distance(r.rest_position_m, c.rest),
-                r.iterations);
+    std::printf(
+        "[rest shape] noise sigma %.1e m (%.0e of length): max |dX| %.3g m, mean |dX| %.3g m, "
+        "%d iterations\n",
+        sigmas[k], sigmas[k] / kLength, errors[k], mean_node_distance(r.rest_position_m, c.rest), r.iterations);
   }
   // The error follows the noise (same pattern, 10x larger) and stays far below the sag.
   EXPECT_NEAR(errors[1] / errors[0], 10.0, 1.0);

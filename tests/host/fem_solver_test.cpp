@@ -113,7 +113,8 @@ TEST(FemSolver, LinearStaticMatchesSparseLdltOracle) {
   const Eigen::VectorXd u = ldlt.solve(rhs);
   Eigen::VectorXd ours(free);
   for (int i = 0; i < model.dof_count(); ++i) {
-    if (map[static_cast<std::size_t>(i)] >= 0) ours[map[static_cast<std::size_t>(i)]] = result.position_m[i] - model.rest_position_m()[i];
+    if (map[static_cast<std::size_t>(i)] >= 0)
+      ours[map[static_cast<std::size_t>(i)]] = result.position_m[i] - model.rest_position_m()[i];
   }
   EXPECT_LT((ours - u).norm(), 1e-6 * u.norm());
 }
@@ -133,7 +134,8 @@ TEST(FemSolver, PatchTestUniaxialStress) {
     const Eigen::Matrix3d q = Eigen::AngleAxisd(angle, Eigen::Vector3d(1, 1, -2).normalized()).toRotationMatrix();
     const Eigen::Vector3d t(0.3, -0.2, 0.7);
     auto exact = [&](const Eigen::Vector3d& p) {
-      return Eigen::Vector3d(q * Eigen::Vector3d(p.x() * (1 + eps), p.y() * (1 - nu * eps), p.z() * (1 - nu * eps)) + t);
+      return Eigen::Vector3d(q * Eigen::Vector3d(p.x() * (1 + eps), p.y() * (1 - nu * eps), p.z() * (1 - nu * eps)) +
+                             t);
     };
     std::vector<int> boundary;
     for (int i = 0; i < model.node_count(); ++i) {
@@ -225,8 +227,8 @@ TEST(FemSolver, ReactionsBalanceLoadsAndGravityStaticAndDynamic) {
       solver.step(state, 0.01, none(), load, options);
       Eigen::Vector3d inertia = Eigen::Vector3d::Zero();
       for (int i = 0; i < model.node_count(); ++i) {
-        inertia += model.lumped_mass_kg()[i] *
-                   (state.acceleration_m_s2.segment<3>(3 * i) + m.rayleigh_alpha * state.velocity_m_s.segment<3>(3 * i));
+        inertia += model.lumped_mass_kg()[i] * (state.acceleration_m_s2.segment<3>(3 * i) +
+                                                m.rayleigh_alpha * state.velocity_m_s.segment<3>(3 * i));
       }
       EXPECT_LT((fem::net_force(solver.reaction_n(), clamp) - (inertia - applied - weight)).norm(), 1e-7 * scale)
           << "step " << k;
@@ -245,17 +247,20 @@ TEST(FemSolver, DrivenNodesFollowFixedNodesStay) {
   EXPECT_EQ(solver.free_node_count(), model.node_count() - static_cast<int>(clamp.size() + tool.size()));
   fem::FemState state = solver.rest_state();
   Eigen::VectorXd rest_tool(3 * static_cast<Eigen::Index>(tool.size()));
-  for (std::size_t k = 0; k < tool.size(); ++k) rest_tool.segment<3>(3 * static_cast<Eigen::Index>(k)) = model.rest_position_m().segment<3>(3 * tool[k]);
+  for (std::size_t k = 0; k < tool.size(); ++k)
+    rest_tool.segment<3>(3 * static_cast<Eigen::Index>(k)) = model.rest_position_m().segment<3>(3 * tool[k]);
   const double dt = 1e-3;
   for (int k = 1; k <= 50; ++k) {
     Eigen::VectorXd target = rest_tool;
-    for (std::size_t j = 0; j < tool.size(); ++j) target[3 * static_cast<Eigen::Index>(j) + 2] += 0.005 * std::sin(0.1 * k);
+    for (std::size_t j = 0; j < tool.size(); ++j)
+      target[3 * static_cast<Eigen::Index>(j) + 2] += 0.005 * std::sin(0.1 * k);
     fem::FemStepOptions options;
     options.integrator = k % 2 == 0 ? fem::FemIntegrator::newmark : fem::FemIntegrator::backward_euler;
     options.substeps = 1 + k % 3;
     solver.step(state, dt, target, none(), options);
     for (std::size_t j = 0; j < tool.size(); ++j) {
-      EXPECT_EQ((state.position_m.segment<3>(3 * tool[j]) - target.segment<3>(3 * static_cast<Eigen::Index>(j))).norm(), 0.0);
+      EXPECT_EQ((state.position_m.segment<3>(3 * tool[j]) - target.segment<3>(3 * static_cast<Eigen::Index>(j))).norm(),
+                0.0);
     }
     for (int node : clamp) {
       EXPECT_EQ((state.position_m.segment<3>(3 * node) - model.rest_position_m().segment<3>(3 * node)).norm(), 0.0);
@@ -287,7 +292,8 @@ TEST(FemSolver, DrivenVelocityUnderNewmark) {
     options.driven_velocity = rule;
     fem::FemState state = solver.rest_state();
     Eigen::VectorXd target(3 * static_cast<Eigen::Index>(tool.size()));
-    for (std::size_t j = 0; j < tool.size(); ++j) target.segment<3>(3 * static_cast<Eigen::Index>(j)) = model.rest_position_m().segment<3>(3 * tool[j]);
+    for (std::size_t j = 0; j < tool.size(); ++j)
+      target.segment<3>(3 * static_cast<Eigen::Index>(j)) = model.rest_position_m().segment<3>(3 * tool[j]);
     for (int k = 1; k <= 6; ++k) {
       for (std::size_t j = 0; j < tool.size(); ++j) target[3 * static_cast<Eigen::Index>(j) + 2] += speed * dt;
       solver.step(state, dt, target, none(), options);

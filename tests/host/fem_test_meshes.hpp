@@ -81,7 +81,9 @@ inline TetMesh read_msh41_tets(const std::string& path) {
 }
 
 /// One of the checked-in IPC meshes by file name, e.g. "bar-2523.msh".
-inline TetMesh ipc_mesh(const std::string& name) { return read_msh41_tets(std::string(PLIANT_FEM_MESH_DIR) + "/" + name); }
+inline TetMesh ipc_mesh(const std::string& name) {
+  return read_msh41_tets(std::string(PLIANT_FEM_MESH_DIR) + "/" + name);
+}
 
 /// Area share (m^2) of every node on the boundary plane {coordinate `axis` = value}: a third of
 /// the area of each tetrahedron face lying in that plane. Sums to the face area. n entries.

@@ -27,16 +27,13 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 std::size_t count(const std::string& text, const std::string& needle) {
   std::size_t n = 0;
-  for (std::size_t at = text.find(needle); at != std::string::npos;
-       at = text.find(needle, at + needle.size())) {
+  for (std::size_t at = text.find(needle); at != std::string::npos; at = text.find(needle, at + needle.size())) {
     ++n;
   }
   return n;
 }
 
-bool contains(const std::string& text, const std::string& needle) {
-  return text.find(needle) != std::string::npos;
-}
+bool contains(const std::string& text, const std::string& needle) { return text.find(needle) != std::string::npos; }
 
 // A pressed 2D grid of `particles`, `frames` frames at 50 Hz; the last fifth is held out.
 void synthetic(Diagnosis& d, DiagnosisEvidence& e, int particles, int frames) {
@@ -59,8 +56,7 @@ void synthetic(Diagnosis& d, DiagnosisEvidence& e, int particles, int frames) {
     e.frame_times_s.push_back(0.02 * f);
     e.held_out.push_back(f * 5 >= frames * 4 ? 1 : 0);
     for (int p = 0; p < particles; ++p) {
-      const auto i = static_cast<std::size_t>(f) * static_cast<std::size_t>(particles) +
-                     static_cast<std::size_t>(p);
+      const auto i = static_cast<std::size_t>(f) * static_cast<std::size_t>(particles) + static_cast<std::size_t>(p);
       const double dent = (p >= 12 && p < 20) ? 0.01 * f : 0.0;
       e.observed[2 * i] = p % 8;
       e.observed[2 * i + 1] = p / 8 - dent + 0.01 * noise();
@@ -106,8 +102,7 @@ void synthetic(Diagnosis& d, DiagnosisEvidence& e, int particles, int frames) {
 
 // True when some occurrence of `prefix` is followed by anything but `allowed`.
 bool has_prefix_not_followed_by(const std::string& html, const std::string& prefix, char allowed) {
-  for (std::size_t at = html.find(prefix); at != std::string::npos;
-       at = html.find(prefix, at + 1)) {
+  for (std::size_t at = html.find(prefix); at != std::string::npos; at = html.find(prefix, at + 1)) {
     const std::size_t next = at + prefix.size();
     if (next >= html.size() || html[next] != allowed) return true;
   }
@@ -124,9 +119,8 @@ bool has_non_finite_number(const std::string& html) {
       if (before > 0 && html[before - 1] == '-') --before;
       if (before == 0 || delimiters.find(html[before - 1]) == std::string::npos) continue;
       const std::size_t after = at + 3;
-      const bool word_ends = after >= html.size() ||
-                             !(std::isalnum(static_cast<unsigned char>(html[after])) ||
-                               html[after] == '_');
+      const bool word_ends =
+          after >= html.size() || !(std::isalnum(static_cast<unsigned char>(html[after])) || html[after] == '_');
       if (word_ends) return true;
     }
   }
@@ -136,8 +130,7 @@ bool has_non_finite_number(const std::string& html) {
 // Every <svg> opening tag, in order.
 std::vector<std::string> svg_tags(const std::string& html) {
   std::vector<std::string> tags;
-  for (std::size_t at = html.find("<svg"); at != std::string::npos;
-       at = html.find("<svg", at + 4)) {
+  for (std::size_t at = html.find("<svg"); at != std::string::npos; at = html.find("<svg", at + 4)) {
     tags.push_back(html.substr(at, html.find('>', at) - at + 1));
   }
   return tags;
@@ -182,9 +175,8 @@ TEST(HtmlReport, SyntheticPageHasEveryPlotAndTable) {
   synthetic(d, e, 32, 150);
   const std::string html = diagnosis_html(d, e);
   expect_self_contained(html);
-  const std::vector<std::string> expected = {"residual_before", "residual_after", "trajectory_12",
-                                             "trajectory_13",   "trajectory_14",  "trajectory_15",
-                                             "trajectory_16",   "trajectory_17"};
+  const std::vector<std::string> expected = {"residual_before", "residual_after", "trajectory_12", "trajectory_13",
+                                             "trajectory_14",   "trajectory_15",  "trajectory_16", "trajectory_17"};
   EXPECT_EQ(plot_names(html), expected);  // at most six trajectories
   EXPECT_TRUE(contains(html, "Showing the first 6 of 8 located particles"));
   for (const char* table : {"summary", "candidates", "parameters", "signatures"}) {
@@ -328,8 +320,7 @@ TEST(HtmlReport, MismatchedArraysSkipPlotsWithoutCrashing) {
   d.location.particles = {0};
   html = diagnosis_html(d, e);
   expect_self_contained(html);
-  EXPECT_EQ(plot_names(html),
-            (std::vector<std::string>{"residual_before", "residual_after", "trajectory_0"}));
+  EXPECT_EQ(plot_names(html), (std::vector<std::string>{"residual_before", "residual_after", "trajectory_0"}));
 }
 
 TEST(HtmlReport, HugeInputsAreBinnedToAFewMegabytes) {

@@ -12,9 +12,9 @@
 
 namespace {
 
+using pliant::host::fem::fit_least_squares;
 using pliant::host::fem::FitOptions;
 using pliant::host::fem::FitParameter;
-using pliant::host::fem::fit_least_squares;
 using pliant::host::fem::RobustLoss;
 
 struct Line {
@@ -36,20 +36,24 @@ Line noisy_line(double slope, double intercept, double sigma, int n, unsigned se
 TEST(LeastSquaresFit, LinearRegressionMatchesClosedForm) {
   const Line line = noisy_line(2.0, 0.5, 0.1, 50, 3);
   const size_t n = line.x.size();
-  std::vector<FitParameter> parameters = {{"slope", 1.0, -10.0, 10.0, false},
-                                          {"intercept", 0.0, -10.0, 10.0, false}};
+  std::vector<FitParameter> parameters = {{"slope", 1.0, -10.0, 10.0, false}, {"intercept", 0.0, -10.0, 10.0, false}};
   FitOptions options;
   options.loss = RobustLoss::none;
-  const auto result = fit_least_squares(parameters, static_cast<int>(n), [&](const std::vector<double>& v,
-                                                           std::vector<double>& r) {
-    for (size_t i = 0; i < n; ++i) r[i] = v[0] * line.x[i] + v[1] - line.y[i];
-    return true;
-  }, options);
+  const auto result = fit_least_squares(
+      parameters, static_cast<int>(n),
+      [&](const std::vector<double>& v, std::vector<double>& r) {
+        for (size_t i = 0; i < n; ++i) r[i] = v[0] * line.x[i] + v[1] - line.y[i];
+        return true;
+      },
+      options);
 
   // Closed form: normal equations and the textbook standard error of the slope.
   double sx = 0, sy = 0, sxx = 0, sxy = 0;
   for (size_t i = 0; i < n; ++i) {
-    sx += line.x[i]; sy += line.y[i]; sxx += line.x[i] * line.x[i]; sxy += line.x[i] * line.y[i];
+    sx += line.x[i];
+    sy += line.y[i];
+    sxx += line.x[i] * line.x[i];
+    sxy += line.x[i] * line.y[i];
   }
   const double count = static_cast<double>(n);
   const double slope = (count * sxy - sx * sy) / (count * sxx - sx * sx);
@@ -84,11 +88,11 @@ TEST_P(DecayFromFarStart, ConvergesToTruth) {
   const double factor = GetParam();
   std::vector<FitParameter> parameters = {{"amplitude", a * factor, 1e-3, 1e3, true},
                                           {"time_constant", tau * factor, 1e-3, 1e3, true}};
-  const auto result = fit_least_squares(parameters, static_cast<int>(n), [&](const std::vector<double>& v,
-                                                           std::vector<double>& r) {
-    for (size_t i = 0; i < n; ++i) r[i] = v[0] * std::exp(-t[i] / v[1]) - y[i];
-    return true;
-  });
+  const auto result =
+      fit_least_squares(parameters, static_cast<int>(n), [&](const std::vector<double>& v, std::vector<double>& r) {
+        for (size_t i = 0; i < n; ++i) r[i] = v[0] * std::exp(-t[i] / v[1]) - y[i];
+        return true;
+      });
   EXPECT_NEAR(result.values[0], a, 1e-5 * a);
   EXPECT_NEAR(result.values[1], tau, 1e-5 * tau);
 }
@@ -147,8 +151,7 @@ TEST(LeastSquaresFit, HuberIgnoresOutliersThatBiasPlainLeastSquares) {
   Line line = noisy_line(2.0, 0.5, 0.02, 60, 11);
   for (size_t i = 40; i < 60; i += 4) line.y[i] += 3.0;  // five gross outliers at the high end
   const size_t n = line.x.size();
-  std::vector<FitParameter> parameters = {{"slope", 1.0, -10.0, 10.0, false},
-                                          {"intercept", 0.0, -10.0, 10.0, false}};
+  std::vector<FitParameter> parameters = {{"slope", 1.0, -10.0, 10.0, false}, {"intercept", 0.0, -10.0, 10.0, false}};
   auto residuals = [&](const std::vector<double>& v, std::vector<double>& r) {
     for (size_t i = 0; i < n; ++i) r[i] = v[0] * line.x[i] + v[1] - line.y[i];
     return true;
@@ -167,8 +170,7 @@ TEST(LeastSquaresFit, HuberIgnoresOutliersThatBiasPlainLeastSquares) {
 
 TEST(LeastSquaresFit, StopsAtBoundAndSaysSo) {
   std::vector<FitParameter> parameters = {{"x", 1.0, 0.5, 2.0, true}};
-  const auto result = fit_least_squares(parameters, 1, [](const std::vector<double>& v,
-                                                          std::vector<double>& r) {
+  const auto result = fit_least_squares(parameters, 1, [](const std::vector<double>& v, std::vector<double>& r) {
     r[0] = v[0] - 5.0;  // optimum outside the bounds
     return true;
   });
@@ -181,13 +183,15 @@ TEST(LeastSquaresFit, UndeterminedParameterHasNoStandardDeviation) {
   std::vector<FitParameter> parameters = {{"a", 1.0, -5.0, 5.0, false}, {"b", 1.0, -5.0, 5.0, false}};
   FitOptions options;
   options.loss = RobustLoss::none;
-  const auto result = fit_least_squares(parameters, 3, [](const std::vector<double>& v,
-                                                          std::vector<double>& r) {
-    r[0] = v[0] + v[1] - 1.0;
-    r[1] = 0.5 * (v[0] + v[1]) - 0.5;
-    r[2] = 2.0 * (v[0] + v[1]) - 2.1;
-    return true;
-  }, options);
+  const auto result = fit_least_squares(
+      parameters, 3,
+      [](const std::vector<double>& v, std::vector<double>& r) {
+        r[0] = v[0] + v[1] - 1.0;
+        r[1] = 0.5 * (v[0] + v[1]) - 0.5;
+        r[2] = 2.0 * (v[0] + v[1]) - 2.1;
+        return true;
+      },
+      options);
   EXPECT_TRUE(std::isnan(result.standard_deviations[0]));
   EXPECT_TRUE(std::isnan(result.standard_deviations[1]));
 }
@@ -198,12 +202,14 @@ TEST(LeastSquaresFit, FailedEvaluationsAreRejectedSteps) {
   std::vector<FitParameter> parameters = {{"x", 0.5, 0.1, 100.0, true}};
   FitOptions options;
   options.loss = RobustLoss::none;
-  const auto result = fit_least_squares(parameters, 1, [](const std::vector<double>& v,
-                                                          std::vector<double>& r) {
-    if (v[0] > 3.0) return false;
-    r[0] = v[0] - 2.5;
-    return true;
-  }, options);
+  const auto result = fit_least_squares(
+      parameters, 1,
+      [](const std::vector<double>& v, std::vector<double>& r) {
+        if (v[0] > 3.0) return false;
+        r[0] = v[0] - 2.5;
+        return true;
+      },
+      options);
   EXPECT_NEAR(result.values[0], 2.5, 1e-6);
 }
 

@@ -33,7 +33,8 @@ struct Scene {
 
   static double press(int frame) { return kDepth * std::clamp((frame - 15) / 30.0, 0.0, 1.0); }
   static std::size_t index(int frame, int id, int axis) {
-    return (static_cast<std::size_t>(frame) * (kCols * kRows) + static_cast<std::size_t>(id)) * 2 + static_cast<std::size_t>(axis);
+    return (static_cast<std::size_t>(frame) * (kCols * kRows) + static_cast<std::size_t>(id)) * 2 +
+           static_cast<std::size_t>(axis);
   }
   double& obs(int frame, int id, int axis) { return rec.positions[index(frame, id, axis)]; }
   void add(int frame, int id, double dx, double dy) {

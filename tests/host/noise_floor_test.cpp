@@ -46,7 +46,8 @@ void hide_particle(Recording& recording, int id) {
   for (int k = 0; k < recording.frame_count(); ++k) {
     for (int d = 0; d < recording.dimension; ++d) {
       recording.positions[(static_cast<std::size_t>(k) * static_cast<std::size_t>(recording.particle_count) +
-                           static_cast<std::size_t>(id)) * static_cast<std::size_t>(recording.dimension) +
+                           static_cast<std::size_t>(id)) *
+                              static_cast<std::size_t>(recording.dimension) +
                           static_cast<std::size_t>(d)] = kNaN;
     }
   }
@@ -82,7 +83,8 @@ TEST(NoiseFloor, NeedsNoFixedParticlesNorStillLeadIn) {
     for (int id : rec.fixed) hide_particle(rec, id);
     rec.fixed.clear();
     // Drop the 0.5 s lead-in at rest, so every remaining track is moving.
-    const Recording moving = keep_frames(rec, [&](int k) { return rec.frame_times_s[static_cast<std::size_t>(k)] > 0.55; });
+    const Recording moving =
+        keep_frames(rec, [&](int k) { return rec.frame_times_s[static_cast<std::size_t>(k)] > 0.55; });
     const double truth = s.truth["noise_std"].get<double>();
     const double ratio = estimate_noise_std(moving) / truth;
     std::cout << "[noise] " << name << " moving tracks only estimate/truth=" << ratio << "\n";

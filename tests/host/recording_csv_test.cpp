@@ -24,12 +24,8 @@ std::string table_error(Table table, const std::string& text) {
         r.dimension = 3;
         parse_particles_csv(text, "particles.csv", r);
         break;
-      case Table::wrench:
-        parse_wrench_csv(text, "wrench.csv");
-        break;
-      case Table::gripper:
-        parse_gripper_csv(text, "gripper.csv");
-        break;
+      case Table::wrench: parse_wrench_csv(text, "wrench.csv"); break;
+      case Table::gripper: parse_gripper_csv(text, "gripper.csv"); break;
     }
   });
 }
@@ -47,8 +43,7 @@ void PrintTo(const CsvCase& c, std::ostream* out) { *out << c.name; }
 class CsvMalformed : public ::testing::TestWithParam<CsvCase> {};
 
 TEST_P(CsvMalformed, NamesFileLineAndCause) {
-  expect_message(table_error(GetParam().table, GetParam().text), GetParam().prefix,
-                 GetParam().cause);
+  expect_message(table_error(GetParam().table, GetParam().text), GetParam().prefix, GetParam().cause);
 }
 
 const std::string kHead2 = "t,id,x,y\n";
@@ -63,12 +58,10 @@ INSTANTIATE_TEST_SUITE_P(
                 "particles.csv:1: ", "header must be exactly 't,id,x,y,z'"},
         CsvCase{"TooFewFields", Table::particles_2d, kHead2 + "0,0,0,0\n0,1,1\n",
                 "particles.csv:3: ", "expected 4 fields (t,id,x,y), found 3"},
-        CsvCase{"TooManyFields", Table::particles_2d, kHead2 + "0,0,0,0,0\n",
-                "particles.csv:2: ", "expected 4 fields"},
+        CsvCase{"TooManyFields", Table::particles_2d, kHead2 + "0,0,0,0,0\n", "particles.csv:2: ", "expected 4 fields"},
         CsvCase{"TimeNotNumber", Table::particles_2d, kHead2 + "zero,0,0,0\n",
                 "particles.csv:2: ", "t: expected a number, found 'zero'"},
-        CsvCase{"TimeNan", Table::particles_2d, kHead2 + "nan,0,0,0\n",
-                "particles.csv:2: ", "t: must be finite"},
+        CsvCase{"TimeNan", Table::particles_2d, kHead2 + "nan,0,0,0\n", "particles.csv:2: ", "t: must be finite"},
         CsvCase{"IdFractional", Table::particles_2d, kHead2 + "0,1.5,0,0\n",
                 "particles.csv:2: ", "id: expected an integer, found '1.5'"},
         CsvCase{"IdOutOfRange", Table::particles_2d, kHead2 + "0,0,0,0\n0,40,0,0\n",
@@ -95,23 +88,22 @@ INSTANTIATE_TEST_SUITE_P(
                 "particles.csv:3: ", "empty line"}),
     CaseName());
 
-INSTANTIATE_TEST_SUITE_P(
-    Samples, CsvMalformed,
-    ::testing::Values(CsvCase{"WrenchHeader", Table::wrench, "t,fx,fy,fz\n0,0,0,0\n",
-                              "wrench.csv:1: ", "header must be exactly 't,fx,fy,fz,tx,ty,tz'"},
-                      CsvCase{"WrenchNan", Table::wrench, "t,fx,fy,fz,tx,ty,tz\n0,1,2,3,nan,0,0\n",
-                              "wrench.csv:2: ", "tx: must be finite"},
-                      CsvCase{"WrenchRepeatedTime", Table::wrench,
-                              "t,fx,fy,fz,tx,ty,tz\n0,1,2,3,0,0,0\n0,1,2,3,0,0,0\n",
-                              "wrench.csv:3: ", "t 0 is not after the previous row's t 0"},
-                      CsvCase{"GripperFieldCount", Table::gripper, "t,width,force\n0,0.05\n",
-                              "gripper.csv:2: ", "expected 3 fields (t,width,force), found 2"},
-                      CsvCase{"GripperTimeGoesBack", Table::gripper,
-                              "t,width,force\n1,0.05,2\n0.5,0.04,3\n",
-                              "gripper.csv:3: ", "t 0.5 is not after the previous row's t 1"},
-                      CsvCase{"GripperNotNumber", Table::gripper, "t,width,force\n1,wide,2\n",
-                              "gripper.csv:2: ", "width: expected a number, found 'wide'"}),
-    CaseName());
+INSTANTIATE_TEST_SUITE_P(Samples, CsvMalformed,
+                         ::testing::Values(CsvCase{"WrenchHeader", Table::wrench, "t,fx,fy,fz\n0,0,0,0\n",
+                                                   "wrench.csv:1: ", "header must be exactly 't,fx,fy,fz,tx,ty,tz'"},
+                                           CsvCase{"WrenchNan", Table::wrench, "t,fx,fy,fz,tx,ty,tz\n0,1,2,3,nan,0,0\n",
+                                                   "wrench.csv:2: ", "tx: must be finite"},
+                                           CsvCase{"WrenchRepeatedTime", Table::wrench,
+                                                   "t,fx,fy,fz,tx,ty,tz\n0,1,2,3,0,0,0\n0,1,2,3,0,0,0\n",
+                                                   "wrench.csv:3: ", "t 0 is not after the previous row's t 0"},
+                                           CsvCase{"GripperFieldCount", Table::gripper, "t,width,force\n0,0.05\n",
+                                                   "gripper.csv:2: ", "expected 3 fields (t,width,force), found 2"},
+                                           CsvCase{"GripperTimeGoesBack", Table::gripper,
+                                                   "t,width,force\n1,0.05,2\n0.5,0.04,3\n",
+                                                   "gripper.csv:3: ", "t 0.5 is not after the previous row's t 1"},
+                                           CsvCase{"GripperNotNumber", Table::gripper, "t,width,force\n1,wide,2\n",
+                                                   "gripper.csv:2: ", "width: expected a number, found 'wide'"}),
+                         CaseName());
 
 // --- valid tables
 
@@ -134,8 +126,7 @@ TEST(ParticlesCsv, TwoDimensionalFrames) {
 }
 
 TEST(ParticlesCsv, ThreeDimensionalRowsInAnyOrder) {
-  const Recording r =
-      particles(3, 2, "t,id,x,y,z\n0.1,1,4,5,6\n0.1,0,1,2,3\n0.2,0,-1e-3,2.5E2,.5\n");
+  const Recording r = particles(3, 2, "t,id,x,y,z\n0.1,1,4,5,6\n0.1,0,1,2,3\n0.2,0,-1e-3,2.5E2,.5\n");
   ASSERT_EQ(r.frame_count(), 2);
   EXPECT_EQ(r.position(0, 0, 2), 3.0);
   EXPECT_EQ(r.position(0, 1, 0), 4.0);
@@ -164,9 +155,7 @@ TEST(ParticlesCsv, CrlfBomAndMissingFinalNewline) {
   EXPECT_EQ(r.position(1, 0, 1), 6.0);
 }
 
-TEST(ParticlesCsv, HeaderOnlyHasNoFrames) {
-  EXPECT_EQ(particles(2, 2, "t,id,x,y\n").frame_count(), 0);
-}
+TEST(ParticlesCsv, HeaderOnlyHasNoFrames) { EXPECT_EQ(particles(2, 2, "t,id,x,y\n").frame_count(), 0); }
 
 TEST(ParticlesCsv, ErrorLineCountsCrlfLines) {
   expect_message(table_error(Table::particles_2d, "t,id,x,y\r\n0,0,0,0\r\n0,9,0,0\r\n"),
@@ -174,8 +163,7 @@ TEST(ParticlesCsv, ErrorLineCountsCrlfLines) {
 }
 
 TEST(WrenchCsv, ReadsForceAndTorque) {
-  const auto w = parse_wrench_csv("t,fx,fy,fz,tx,ty,tz\n0,1,2,3,4,5,6\n0.25,-1,-2,-3,-4,-5,-6\n",
-                                  "wrench.csv");
+  const auto w = parse_wrench_csv("t,fx,fy,fz,tx,ty,tz\n0,1,2,3,4,5,6\n0.25,-1,-2,-3,-4,-5,-6\n", "wrench.csv");
   ASSERT_EQ(w.size(), 2u);
   EXPECT_EQ(w[1].t_s, 0.25);
   EXPECT_EQ(w[0].force_n[2], 3.0);

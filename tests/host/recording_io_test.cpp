@@ -53,8 +53,7 @@ TEST(ReadRecordingErrors, MissingRecordingJson) {
 TEST(ReadRecordingErrors, MissingParticlesFile) {
   TempDir dir;
   dir.write("recording.json", kMinimalJson2D);
-  expect_message(read_error(dir.str()),
-                 "particles.csv: ", "no such file (named in recording.json files.particles)");
+  expect_message(read_error(dir.str()), "particles.csv: ", "no such file (named in recording.json files.particles)");
 }
 
 TEST(ReadRecordingErrors, MissingMediaFile) {
@@ -63,8 +62,7 @@ TEST(ReadRecordingErrors, MissingMediaFile) {
   doc["files"]["video"] = "media/cam.mp4";
   dir.write("recording.json", doc.dump());
   dir.write("particles.csv", kParticles2D);
-  expect_message(read_error(dir.str()),
-                 "media/cam.mp4: ", "no such file (named in recording.json files.video)");
+  expect_message(read_error(dir.str()), "media/cam.mp4: ", "no such file (named in recording.json files.video)");
 }
 
 TEST(ReadRecordingErrors, SymlinkLeavingTheDirectory) {
@@ -147,8 +145,7 @@ TEST(ReadRecordingErrors, FirstFrameMissesAParticle) {
   TempDir dir;
   dir.write("recording.json", kMinimalJson2D);
   dir.write("particles.csv", "t,id,x,y\n0,0,0,0\n0,1,1,0\n0,3,1,1\n1,2,0,1\n");
-  expect_message(read_error(dir.str()),
-                 "particles.csv: ", "the first frame (t=0) does not observe particle 2");
+  expect_message(read_error(dir.str()), "particles.csv: ", "the first frame (t=0) does not observe particle 2");
 }
 
 TEST(ReadRecordingErrors, FirstFrameHasNanParticle) {
@@ -339,8 +336,7 @@ TEST(WriteRecording, RewriteIsByteIdenticalAndLeavesNoTemporaries) {
   write_recording(read_recording(first.str()), second.str());
   // Writing over an existing recording replaces it.
   write_recording(read_recording(second.str()), second.str());
-  for (const char* name :
-       {"recording.json", "data/particles.csv", "wrench.csv", "gripper.csv", "mesh.vtk"}) {
+  for (const char* name : {"recording.json", "data/particles.csv", "wrench.csv", "gripper.csv", "mesh.vtk"}) {
     EXPECT_EQ(file_text(first.path() / name), file_text(second.path() / name)) << name;
   }
   for (const auto& entry : fs::recursive_directory_iterator(second.path())) {
@@ -353,9 +349,8 @@ TEST(WriteRecording, RecordingJsonListsSpecKeysInOrder) {
   write_recording(full_recording(), dir.str());
   const std::string text = file_text(dir.path() / "recording.json");
   std::size_t previous = 0;
-  for (const char* key : {"\"format\"", "\"version\"", "\"dimension\"", "\"length_unit\"",
-                          "\"gravity\"", "\"particles\"", "\"files\"", "\"wrench\"", "\"material\"",
-                          "\"meta\"", "\"calibration\""}) {
+  for (const char* key : {"\"format\"", "\"version\"", "\"dimension\"", "\"length_unit\"", "\"gravity\"",
+                          "\"particles\"", "\"files\"", "\"wrench\"", "\"material\"", "\"meta\"", "\"calibration\""}) {
     const std::size_t at = text.find(key);
     ASSERT_NE(at, std::string::npos) << key;
     EXPECT_GT(at, previous) << key;

@@ -44,18 +44,16 @@ TEST_P(JsonSyntax, NamesLineColumnAndCause) {
 
 INSTANTIATE_TEST_SUITE_P(
     Malformed, JsonSyntax,
-    ::testing::Values(
-        SyntaxCase{"MissingValue", R"({"format": })", "recording.json:1:12: ", "syntax error"},
-        SyntaxCase{"ErrorOnThirdLine", "{\n  \"format\": \"x\",\n  \"version\" 1\n}",
-                   "recording.json:3:13: ", "syntax error"},
-        SyntaxCase{"TrailingGarbage", "{}\n}", "recording.json:2:1: ", "syntax error"},
-        SyntaxCase{"Empty", "", "recording.json:1:1: ", "unexpected end of input"},
-        SyntaxCase{"InvalidUtf8", "{\"a\": \"\xff\"}", "recording.json:1:8: ", "UTF-8"},
-        SyntaxCase{"NestedTooDeep",
-                   "{\"meta\": " + std::string(200, '[') + std::string(200, ']') + "}",
-                   "recording.json:1:109: ", "nested deeper than 100 levels"},
-        SyntaxCase{"NumberOverflow", "{\"meta\": \"1e999\",\n \"format\": 1e999}",
-                   "recording.json:2:12: ", "number overflow parsing '1e999'"}),
+    ::testing::Values(SyntaxCase{"MissingValue", R"({"format": })", "recording.json:1:12: ", "syntax error"},
+                      SyntaxCase{"ErrorOnThirdLine", "{\n  \"format\": \"x\",\n  \"version\" 1\n}",
+                                 "recording.json:3:13: ", "syntax error"},
+                      SyntaxCase{"TrailingGarbage", "{}\n}", "recording.json:2:1: ", "syntax error"},
+                      SyntaxCase{"Empty", "", "recording.json:1:1: ", "unexpected end of input"},
+                      SyntaxCase{"InvalidUtf8", "{\"a\": \"\xff\"}", "recording.json:1:8: ", "UTF-8"},
+                      SyntaxCase{"NestedTooDeep", "{\"meta\": " + std::string(200, '[') + std::string(200, ']') + "}",
+                                 "recording.json:1:109: ", "nested deeper than 100 levels"},
+                      SyntaxCase{"NumberOverflow", "{\"meta\": \"1e999\",\n \"format\": 1e999}",
+                                 "recording.json:2:12: ", "number overflow parsing '1e999'"}),
     CaseName());
 
 // --- semantic errors: key path and cause
@@ -86,12 +84,9 @@ INSTANTIATE_TEST_SUITE_P(
                 "recording.json: format: ", "missing required key"},
         KeyCase{"FormatWrong", [](json& d) { d["format"] = "pliant"; },
                 "recording.json: format: ", "must be \"pliant-recording\""},
-        KeyCase{"VersionTwo", [](json& d) { d["version"] = 2; },
-                "recording.json: version: ", "must be 1"},
-        KeyCase{"VersionString", [](json& d) { d["version"] = "1"; },
-                "recording.json: version: ", "must be 1"},
-        KeyCase{"DimensionFour", [](json& d) { d["dimension"] = 4; },
-                "recording.json: dimension: ", "must be 2 or 3"},
+        KeyCase{"VersionTwo", [](json& d) { d["version"] = 2; }, "recording.json: version: ", "must be 1"},
+        KeyCase{"VersionString", [](json& d) { d["version"] = "1"; }, "recording.json: version: ", "must be 1"},
+        KeyCase{"DimensionFour", [](json& d) { d["dimension"] = 4; }, "recording.json: dimension: ", "must be 2 or 3"},
         KeyCase{"LengthUnitMillimetre", [](json& d) { d["length_unit"] = "mm"; },
                 "recording.json: length_unit: ", "must be \"m\" or \"px\""},
         KeyCase{"GravityWrongLength",
@@ -170,8 +165,7 @@ INSTANTIATE_TEST_SUITE_P(
                 "recording.json: particles.driven[0].form: ", "unknown key"},
         KeyCase{"ParticlesUnknownKey", [](json& d) { d["particles"]["fixd"] = {0}; },
                 "recording.json: particles.fixd: ", "unknown key"},
-        KeyCase{"FilesMissing", [](json& d) { d.erase("files"); },
-                "recording.json: files: ", "missing required key"},
+        KeyCase{"FilesMissing", [](json& d) { d.erase("files"); }, "recording.json: files: ", "missing required key"},
         KeyCase{"FilesParticlesMissing",
                 [](json& d) {
                   d["files"] = {{"wrench", "wrench.csv"}};
@@ -179,22 +173,15 @@ INSTANTIATE_TEST_SUITE_P(
                 "recording.json: files.particles: ", "missing required key"},
         KeyCase{"FilesAbsolutePath", [](json& d) { d["files"]["particles"] = "/etc/passwd"; },
                 "recording.json: files.particles: ", "must be relative"},
-        KeyCase{"FilesParentDirectory",
-                [](json& d) { d["files"]["video"] = "media/../../secret.mp4"; },
+        KeyCase{"FilesParentDirectory", [](json& d) { d["files"]["video"] = "media/../../secret.mp4"; },
                 "recording.json: files.video: ", "must not contain '..'"},
         KeyCase{"FilesNotString", [](json& d) { d["files"]["particles"] = 3; },
                 "recording.json: files.particles: ", "must be a string"},
         KeyCase{"WrenchWithoutAppliedTo", [](json& d) { d["files"]["wrench"] = "wrench.csv"; },
                 "recording.json: wrench.applied_to: ", "required when files.wrench is present"},
-        KeyCase{"AppliedToOutOfRange",
-                [](json& d) {
-                  d["wrench"] = {{"applied_to", {7}}};
-                },
+        KeyCase{"AppliedToOutOfRange", [](json& d) { d["wrench"] = {{"applied_to", {7}}}; },
                 "recording.json: wrench.applied_to[0]: ", "id 7 out of range 0..3"},
-        KeyCase{"MaterialNotNumber",
-                [](json& d) {
-                  d["material"] = {{"poisson_ratio", "0.45"}};
-                },
+        KeyCase{"MaterialNotNumber", [](json& d) { d["material"] = {{"poisson_ratio", "0.45"}}; },
                 "recording.json: material.poisson_ratio: ", "must be a number"}),
     CaseName());
 

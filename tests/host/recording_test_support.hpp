@@ -47,12 +47,9 @@ std::string error_of(Action&& action) {
 
 /// Checks the one-line message format: starts with `prefix` (file and line, or file and key)
 /// and contains `cause`.
-inline void expect_message(const std::string& message, const std::string& prefix,
-                           const std::string& cause) {
-  EXPECT_EQ(message.rfind(prefix, 0), 0u)
-      << "message: " << message << "\nexpected prefix: " << prefix;
-  EXPECT_NE(message.find(cause), std::string::npos)
-      << "message: " << message << "\nexpected cause: " << cause;
+inline void expect_message(const std::string& message, const std::string& prefix, const std::string& cause) {
+  EXPECT_EQ(message.rfind(prefix, 0), 0u) << "message: " << message << "\nexpected prefix: " << prefix;
+  EXPECT_NE(message.find(cause), std::string::npos) << "message: " << message << "\nexpected cause: " << cause;
   EXPECT_EQ(message.find('\n'), std::string::npos) << "message spans lines: " << message;
 }
 

@@ -53,7 +53,6 @@ std::string read_text(const fs::path& path) {
   return text.str();
 }
 
-
 ScenarioOptions noisy() {
   ScenarioOptions options;
   options.msm_beta = 0.5;
@@ -73,7 +72,8 @@ TEST(scenario_effects, EveryEffectChangesEveryScenarioAtTheSameSeed) {
       // The smallest default effect (friction on the dome) moves its support by 3e-3 spacings.
       EXPECT_GT(max_difference(plain.recording, changed.recording), 1e-3 * spacing) << scenario << " " << effect;
       // Same noise draws: frame 0 (the still object) is identical.
-      for (std::size_t k = 0; k < static_cast<std::size_t>(plain.recording.particle_count * plain.recording.dimension); ++k) {
+      for (std::size_t k = 0; k < static_cast<std::size_t>(plain.recording.particle_count * plain.recording.dimension);
+           ++k) {
         ASSERT_EQ(plain.recording.positions[k], changed.recording.positions[k]) << scenario << " " << effect;
       }
       EXPECT_EQ(changed.truth.at("effect").get<std::string>(), effect);
@@ -82,11 +82,16 @@ TEST(scenario_effects, EveryEffectChangesEveryScenarioAtTheSameSeed) {
 }
 
 TEST(scenario_effects, NullValuesReproduceTheRecordingWithoutEffect) {
-  const std::vector<std::string> nulls = {
-      "plasticity:creep=0",   "viscosity:fraction=0,damping=0", "friction:mu=inf",
-      "gravity:g=0,tilt=30",  "heterogeneity:ratio=1",          "stiffening:k=0",
-      "heterogeneity:ratio=1,region=left", "none"};
-  for (const std::string& scenario : {std::string("foam_press"), std::string("dome_press"), std::string("cantilever_strip")}) {
+  const std::vector<std::string> nulls = {"plasticity:creep=0",
+                                          "viscosity:fraction=0,damping=0",
+                                          "friction:mu=inf",
+                                          "gravity:g=0,tilt=30",
+                                          "heterogeneity:ratio=1",
+                                          "stiffening:k=0",
+                                          "heterogeneity:ratio=1,region=left",
+                                          "none"};
+  for (const std::string& scenario :
+       {std::string("foam_press"), std::string("dome_press"), std::string("cantilever_strip")}) {
     ScenarioOptions options = noisy();
     options.substeps = 2;
     options.cluster_radius_factor = 1.8;
@@ -131,7 +136,8 @@ TEST(scenario_effects, GravityActsAlongDownWithoutAGravityKey) {
   const Recording& b = heavy.recording;
   const int frame = 29;  // 0.483 s at 60 frames/s
   double lowest = 0.0;
-  for (int i = 0; i < a.particle_count; ++i) lowest = std::min(lowest, b.position(frame, i, 1) - a.position(frame, i, 1));
+  for (int i = 0; i < a.particle_count; ++i)
+    lowest = std::min(lowest, b.position(frame, i, 1) - a.position(frame, i, 1));
   EXPECT_LT(lowest, -0.05 * 0.01);
   const auto gravity = heavy.truth.at("effect_details").at("gravity_vector").get<std::vector<double>>();
   ASSERT_EQ(gravity.size(), 2u);
@@ -160,12 +166,16 @@ TEST(scenario_effects, BadEffectTextsAreRefusedNamingTheValidOnes) {
     std::string mentions;
   };
   const std::vector<Bad> cases = {
-      {"plastic", "plasticity, viscosity"},         {"plasticity:foo=1", "yield, creep, max"},
+      {"plastic", "plasticity, viscosity"},
+      {"plasticity:foo=1", "yield, creep, max"},
       {"heterogeneity:region=middle", "inclusion, left, right"},
       {"heterogeneity:region=3", "inclusion, left, right"},
-      {"stiffening:k=stiff", "k must be a number"}, {"gravity:g=-1", "g must be >= 0"},
-      {"viscosity:fraction=1", "fraction"},         {"friction:mu=nan", "mu"},
-      {"heterogeneity:ratio=3", "ratio"},           {"none:x=1", "none"},
+      {"stiffening:k=stiff", "k must be a number"},
+      {"gravity:g=-1", "g must be >= 0"},
+      {"viscosity:fraction=1", "fraction"},
+      {"friction:mu=nan", "mu"},
+      {"heterogeneity:ratio=3", "ratio"},
+      {"none:x=1", "none"},
   };
   for (const Bad& bad : cases) {
     try {
@@ -247,7 +257,9 @@ TEST(scenario_effects, SubstepsAndClusterRadiusChangeTheGeneratorAndAreRecorded)
   EXPECT_GT(max_difference(plain.recording, wider.recording), 0.1);
   EXPECT_DOUBLE_EQ(wider.truth.at("cluster_radius_factor").get<double>(), 2.2);
   options.cluster_radius_factor = 1.8;
-  EXPECT_GT(max_difference(make_scenario("dome_press", noisy()).recording, make_scenario("dome_press", options).recording), 1e-4);
+  EXPECT_GT(
+      max_difference(make_scenario("dome_press", noisy()).recording, make_scenario("dome_press", options).recording),
+      1e-4);
   options = noisy();
   options.substeps = 1;
   options.cluster_radius_factor = 1.5;
@@ -283,10 +295,13 @@ TEST(scenario_effects, ReleaseAndDepthShapeTheToolMotion) {
 
 TEST(scenario_effects, OptionsOutOfRangeAreRefused) {
   const std::vector<void (*)(ScenarioOptions&)> breakers = {
-      [](ScenarioOptions& o) { o.substeps = 0; },        [](ScenarioOptions& o) { o.substeps = 65; },
+      [](ScenarioOptions& o) { o.substeps = 0; },
+      [](ScenarioOptions& o) { o.substeps = 65; },
       [](ScenarioOptions& o) { o.cluster_radius_factor = 0.9; },
-      [](ScenarioOptions& o) { o.occlusion = 0.6; },     [](ScenarioOptions& o) { o.occlusion = -0.1; },
-      [](ScenarioOptions& o) { o.depth = 2.5; },         [](ScenarioOptions& o) { o.depth = -1; },
+      [](ScenarioOptions& o) { o.occlusion = 0.6; },
+      [](ScenarioOptions& o) { o.occlusion = -0.1; },
+      [](ScenarioOptions& o) { o.depth = 2.5; },
+      [](ScenarioOptions& o) { o.depth = -1; },
   };
   for (auto breaker : breakers) {
     ScenarioOptions options;
@@ -328,9 +343,8 @@ TEST(scenario_effects, BlockGridSizesTheBlockAndKeepsTheToolOnTheTopCentre) {
 
 TEST(scenario_effects, BadBlockGridsAreRefused) {
   for (const ScenarioOptions::BlockGrid grid :
-       {ScenarioOptions::BlockGrid{1, 5, 4}, ScenarioOptions::BlockGrid{5, 0, 4},
-        ScenarioOptions::BlockGrid{5, 5, 1}, ScenarioOptions::BlockGrid{65, 5, 4},
-        ScenarioOptions::BlockGrid{5, 5, -3}}) {
+       {ScenarioOptions::BlockGrid{1, 5, 4}, ScenarioOptions::BlockGrid{5, 0, 4}, ScenarioOptions::BlockGrid{5, 5, 1},
+        ScenarioOptions::BlockGrid{65, 5, 4}, ScenarioOptions::BlockGrid{5, 5, -3}}) {
     ScenarioOptions options;
     options.block_grid = grid;
     EXPECT_THROW((void)make_scenario("block_press", options), std::invalid_argument)

@@ -44,10 +44,7 @@ void sample(Diagnosis& d, DiagnosisEvidence& e) {
     e.frame_times_s.push_back(t);
     e.held_out.push_back(f >= 120 ? 1 : 0);
     // Press depth: ramps to 4 mm over 1-2 s, released over 2-2.2 s.
-    const double press = t < 1.0   ? 0.0
-                         : t < 2.0 ? 0.004 * (t - 1.0)
-                         : t < 2.2 ? 0.004 * (2.2 - t) / 0.2
-                                   : 0.0;
+    const double press = t < 1.0 ? 0.0 : t < 2.0 ? 0.004 * (t - 1.0) : t < 2.2 ? 0.004 * (2.2 - t) / 0.2 : 0.0;
     const double set = t < 1.0 ? 0.0 : std::min(0.0014, 0.0014 * (t - 1.0));
     for (int p = 0; p < particles; ++p) {
       const double x = 0.01 * (p % 8);
@@ -75,8 +72,7 @@ void sample(Diagnosis& d, DiagnosisEvidence& e) {
   }
   e.fixed = {0, 1, 2, 3, 4, 5, 6, 7};
   e.driven = {12, 13, 14, 15, 16, 17, 18, 19};
-  e.signatures = {
-      {"persistence_after_unload", 0.82}, {"rate_dependence", 0.07}, {"contact_slip_mm", 0.01}};
+  e.signatures = {{"persistence_after_unload", 0.82}, {"rate_dependence", 0.07}, {"contact_slip_mm", 0.01}};
 
   d.recording = "press_foam_3";
   d.baseline.model = "msm";
@@ -93,8 +89,7 @@ void sample(Diagnosis& d, DiagnosisEvidence& e) {
   d.location.t_start = 2.1;
   d.location.t_end = 2.98;
   d.augmented.model = "msm";
-  d.augmented.parameters = {
-      {"msm_alpha", 1.0}, {"msm_beta", 0.61}, {"yield", 0.04}, {"creep", 0.8}};
+  d.augmented.parameters = {{"msm_alpha", 1.0}, {"msm_beta", 0.61}, {"yield", 0.04}, {"creep", 0.8}};
   d.augmented.parameter_std = {{"msm_beta", 0.02}, {"yield", 0.005}, {"creep", 0.1}};
   d.augmented.rms = 3.1e-4;
   d.improvement = 0.84;

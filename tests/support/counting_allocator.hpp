@@ -31,11 +31,11 @@
 namespace pliant::test::detail {
 void eigen_assertion_failed(const char* expression, const char* file, int line) noexcept;
 }  // namespace pliant::test::detail
-#define eigen_assert(x)                                                            \
-  do {                                                                             \
-    if (!static_cast<bool>(x)) {                                                   \
-      ::pliant::test::detail::eigen_assertion_failed(#x, __FILE__, __LINE__);      \
-    }                                                                              \
+#define eigen_assert(x)                                                       \
+  do {                                                                        \
+    if (!static_cast<bool>(x)) {                                              \
+      ::pliant::test::detail::eigen_assertion_failed(#x, __FILE__, __LINE__); \
+    }                                                                         \
   } while (false)
 #endif
 #include <Eigen/Core>
@@ -44,11 +44,11 @@ void eigen_assertion_failed(const char* expression, const char* file, int line) 
 namespace pliant::test {
 
 struct AllocationCounts {
-  std::size_t news = 0;             ///< operator new / new[] calls (any form)
-  std::size_t deletes = 0;          ///< operator delete / delete[] calls on non-null pointers
-  std::size_t mallocs = 0;          ///< malloc, calloc, realloc, aligned_alloc, memalign, posix_memalign
-  std::size_t frees = 0;            ///< free on non-null pointers
-  std::size_t eigen_violations = 0; ///< failed eigen_assert (e.g. a forbidden Eigen heap allocation)
+  std::size_t news = 0;                    ///< operator new / new[] calls (any form)
+  std::size_t deletes = 0;                 ///< operator delete / delete[] calls on non-null pointers
+  std::size_t mallocs = 0;                 ///< malloc, calloc, realloc, aligned_alloc, memalign, posix_memalign
+  std::size_t frees = 0;                   ///< free on non-null pointers
+  std::size_t eigen_violations = 0;        ///< failed eigen_assert (e.g. a forbidden Eigen heap allocation)
   const char* eigen_expression = nullptr;  ///< the first failed eigen_assert, for the report
   /// Every heap event: a real-time call must report 0.
   std::size_t total() const noexcept { return news + deletes + mallocs + frees + eigen_violations; }

@@ -101,9 +101,9 @@ Bytes recording_stream(std::uint32_t frames) {
 TEST(telemetry_cli, HelpExplainsTheCommand) {
   const CommandResult r = run_pliant("telemetry --help");
   EXPECT_EQ(r.status, 0);
-  for (const char* part : {"--serial", "--baud", "--udp", "--bind", "--file", "-o,--output", "--recording",
-                           "--length-unit", "--count", "--duration", "docs/telemetry.md", "Exit status", "JSON",
-                           "SIGINT"}) {
+  for (const char* part :
+       {"--serial", "--baud", "--udp", "--bind", "--file", "-o,--output", "--recording", "--length-unit", "--count",
+        "--duration", "docs/telemetry.md", "Exit status", "JSON", "SIGINT"}) {
     EXPECT_TRUE(contains(r.out, part)) << part << " in\n" << r.out;
   }
   EXPECT_TRUE(contains(run_pliant("--help").out, "telemetry"));
@@ -165,7 +165,7 @@ TEST(telemetry_cli, FileToJsonLinesFieldByField) {
       for (std::size_t axis = 0; axis < 3; ++axis) {
         EXPECT_EQ(static_cast<float>(p.at("positions")[i][axis].get<double>()), f.positions[id * 3 + axis]) << id;
       }
-      const char* status = f.status[id] == PLIANT_TM_OBSERVED ? "observed"
+      const char* status = f.status[id] == PLIANT_TM_OBSERVED    ? "observed"
                            : f.status[id] == PLIANT_TM_PREDICTED ? "predicted"
                                                                  : "lost";
       EXPECT_EQ(p.at("status")[i], status) << id;
@@ -225,15 +225,15 @@ TEST(telemetry_cli, DamagedFileCountsDropsAndKeepsTheGoodMessages) {
   append(stream, estimate_frame(enc, 1, sample_estimate()));  // good
   Bytes bad = packet_of(verdict_frame(enc, 2, sample_verdict()));
   bad[20] ^= 0x01;
-  append(stream, frame_of(bad));                                  // crc_mismatch: seq 1 missed
-  append(stream, Bytes(2000, 0x41));                              // oversize
+  append(stream, frame_of(bad));      // crc_mismatch: seq 1 missed
+  append(stream, Bytes(2000, 0x41));  // oversize
   append(stream, Bytes{0});
-  append(stream, crafted_frame(3, 2, Bytes(12, 0x04), 1, 2));     // particles with dim 4: out_of_range
-  append(stream, crafted_frame(200, 3, Bytes{}, 1, 2));           // unknown_type
-  enc.next_seq = 10;                                              // 4 .. 9 never arrive
-  append(stream, verdict_frame(enc, 3, sample_verdict()));        // good
+  append(stream, crafted_frame(3, 2, Bytes(12, 0x04), 1, 2));  // particles with dim 4: out_of_range
+  append(stream, crafted_frame(200, 3, Bytes{}, 1, 2));        // unknown_type
+  enc.next_seq = 10;                                           // 4 .. 9 never arrive
+  append(stream, verdict_frame(enc, 3, sample_verdict()));     // good
   const Bytes last = counters_frame(enc, 4, {{1, 1}});
-  append(stream, Bytes(last.begin(), last.end() - 5));            // truncated
+  append(stream, Bytes(last.begin(), last.end() - 5));  // truncated
   const cli_test::TempDir dir;
   write_bytes(dir.path() / "damaged.bin", stream);
   const CommandResult r = run_pliant("telemetry --file " + quoted(dir / "damaged.bin"));
@@ -349,8 +349,8 @@ TEST(telemetry_cli, RefusesANonEmptyRecordingDirectory) {
   write_bytes(dir.path() / "capture.bin", recording_stream(2));
   fs::create_directories(dir.path() / "rec");
   cli_test::write_text(dir.path() / "rec" / "keep.txt", "mine");
-  const CommandResult r = run_pliant("telemetry --file " + quoted(dir / "capture.bin") + " --recording " +
-                                     quoted(dir / "rec"));
+  const CommandResult r =
+      run_pliant("telemetry --file " + quoted(dir / "capture.bin") + " --recording " + quoted(dir / "rec"));
   EXPECT_EQ(r.status, 2);
   EXPECT_EQ(r.err, "pliant telemetry: " + (dir / "rec") + " is not empty; give a new directory for the recording\n");
   EXPECT_EQ(read_text(dir.path() / "rec" / "keep.txt"), "mine");
@@ -447,7 +447,8 @@ class Background {
         buffer_.erase(0, end + 1);
         return out;
       }
-      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+      const auto left =
+          std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
       if (left.count() <= 0) return "";
       pollfd entry{err_, POLLIN, 0};
       if (::poll(&entry, 1, static_cast<int>(left.count())) <= 0) continue;
@@ -541,7 +542,7 @@ TEST(telemetry_cli, UdpDurationAndInterruptWriteTheRecording) {
   ASSERT_FALSE(run.line(10).empty());
   send_datagrams(port, recording_stream(3), 1000);
   std::this_thread::sleep_for(std::chrono::milliseconds(1000));  // time to read the queued datagrams
-  run.signal(SIGINT);  // Ctrl-C: the stream ends, the recording is written
+  run.signal(SIGINT);                                            // Ctrl-C: the stream ends, the recording is written
   EXPECT_EQ(run.wait(10), 0);
   const std::string summary = run.line(5);
   EXPECT_TRUE(contains(summary, "stopped; particle frames 3 kept")) << summary;

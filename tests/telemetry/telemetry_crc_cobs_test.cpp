@@ -112,7 +112,8 @@ TEST(telemetry_cobs, EncodedSizeBoundAndNoZeros) {
       EXPECT_LE(static_cast<std::size_t>(size), n + (n + 253) / 254) << n << " pattern " << pattern;
       for (std::int32_t i = 0; i < size; ++i) ASSERT_NE(out[static_cast<std::size_t>(i)], 0) << i;
       Bytes back(static_cast<std::size_t>(size));
-      const std::int32_t m = pliant_tm_cobs_decode(out.data(), static_cast<std::size_t>(size), back.data(), back.size());
+      const std::int32_t m =
+          pliant_tm_cobs_decode(out.data(), static_cast<std::size_t>(size), back.data(), back.size());
       ASSERT_EQ(m, static_cast<std::int32_t>(n));
       back.resize(n);
       EXPECT_EQ(back, in);
@@ -137,9 +138,9 @@ TEST(telemetry_cobs, EncodeRefusesSmallBuffer) {
 
 TEST(telemetry_cobs, DecodeRejectsMalformed) {
   Bytes out(16);
-  const Bytes past_end = {0x05, 0x11, 0x22};        // code promises 4 bytes, 2 follow
-  const Bytes zero_code = {0x00, 0x11};             // a zero can never appear
-  const Bytes zero_data = {0x03, 0x11, 0x00};       // nor inside a block
+  const Bytes past_end = {0x05, 0x11, 0x22};   // code promises 4 bytes, 2 follow
+  const Bytes zero_code = {0x00, 0x11};        // a zero can never appear
+  const Bytes zero_data = {0x03, 0x11, 0x00};  // nor inside a block
   const Bytes full_block_short = {0xFF, 0x01, 0x02};
   for (const Bytes& bad : {past_end, zero_code, zero_data, full_block_short}) {
     EXPECT_EQ(pliant_tm_cobs_decode(bad.data(), bad.size(), out.data(), out.size()), PLIANT_TM_E_ARGUMENT);

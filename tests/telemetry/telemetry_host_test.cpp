@@ -172,8 +172,8 @@ TEST(telemetry_json, Counters) {
 
 // ---- recordings -----------------------------------------------------------------------------
 
-void add_frame(tm::RecordingBuilder& builder, pliant_tm_encoder_t& enc, std::uint64_t stamp_us,
-               const ParticleFrame& f, std::size_t capacity = 200, std::size_t skip_chunk = SIZE_MAX) {
+void add_frame(tm::RecordingBuilder& builder, pliant_tm_encoder_t& enc, std::uint64_t stamp_us, const ParticleFrame& f,
+               std::size_t capacity = 200, std::size_t skip_chunk = SIZE_MAX) {
   const std::vector<Bytes> chunks = particle_chunks(enc, stamp_us, f, capacity);
   for (std::size_t k = 0; k < chunks.size(); ++k) {
     if (k == skip_chunk) continue;
@@ -192,7 +192,7 @@ TEST(telemetry_recording, FramesFromChunksReadBackWithTheRecordingReader) {
   tm::RecordingBuilder builder;
   const ParticleFrame rest = make_particle_frame(0, 3, 40, true);
   ParticleFrame moved = make_particle_frame(1, 3, 40);  // some predicted, some lost
-  moved.positions[3 * 2 + 1] = kNaNf;                    // observed but not finite: unobserved
+  moved.positions[3 * 2 + 1] = kNaNf;                   // observed but not finite: unobserved
   add_frame(builder, enc, 5'000'000, rest);
   add_frame(builder, enc, 5'033'333, moved);
   builder.finish();
@@ -228,13 +228,13 @@ TEST(telemetry_recording, EveryUnusableFrameCountedOnce) {
   pliant_tm_encoder_t enc;
   pliant_tm_encoder_init(&enc, 0);
   tm::RecordingBuilder builder;
-  add_frame(builder, enc, 1000, make_particle_frame(0, 2, 30));         // predicted particles: before_rest
-  add_frame(builder, enc, 2000, make_particle_frame(1, 2, 30, true));   // kept: the rest shape
-  add_frame(builder, enc, 3000, make_particle_frame(2, 2, 30), 200, 1); // a chunk lost: incomplete
-  add_frame(builder, enc, 2000, make_particle_frame(3, 2, 30));         // stamp of the last kept: time
-  add_frame(builder, enc, 4000, make_particle_frame(4, 3, 30));         // other dimension: shape
-  add_frame(builder, enc, 5000, make_particle_frame(5, 2, 31));         // other count: shape
-  add_frame(builder, enc, 6000, make_particle_frame(6, 2, 30));         // kept
+  add_frame(builder, enc, 1000, make_particle_frame(0, 2, 30));          // predicted particles: before_rest
+  add_frame(builder, enc, 2000, make_particle_frame(1, 2, 30, true));    // kept: the rest shape
+  add_frame(builder, enc, 3000, make_particle_frame(2, 2, 30), 200, 1);  // a chunk lost: incomplete
+  add_frame(builder, enc, 2000, make_particle_frame(3, 2, 30));          // stamp of the last kept: time
+  add_frame(builder, enc, 4000, make_particle_frame(4, 3, 30));          // other dimension: shape
+  add_frame(builder, enc, 5000, make_particle_frame(5, 2, 31));          // other count: shape
+  add_frame(builder, enc, 6000, make_particle_frame(6, 2, 30));          // kept
   // A frame whose second chunk repeats the first: overlapping, incomplete.
   {
     const ParticleFrame f = make_particle_frame(7, 2, 30);
@@ -310,8 +310,8 @@ TEST(telemetry_transport, FileToTheEnd) {
   const Bytes stream = sample_stream(&messages);
   const test_support::TempDir dir("pliant_telemetry_");
   const std::string path = dir / "capture.bin";
-  std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(stream.data()),
-                                              static_cast<std::streamsize>(stream.size()));
+  std::ofstream(path, std::ios::binary)
+      .write(reinterpret_cast<const char*>(stream.data()), static_cast<std::streamsize>(stream.size()));
   tm::FileSource file(path);
   EXPECT_EQ(file.describe(), path);
   std::vector<std::string> lines;
@@ -324,7 +324,8 @@ TEST(telemetry_transport, FileToTheEnd) {
   const json last = json::parse(lines.back());
   EXPECT_EQ(last.at("counters").at("5399").get<std::uint32_t>(), 0x1113030Du);
   const std::string summary = tm::stream_summary(r);
-  EXPECT_NE(summary.find("messages " + std::to_string(messages) + " (estimate 5, verdict 5"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("messages " + std::to_string(messages) + " (estimate 5, verdict 5"), std::string::npos)
+      << summary;
   EXPECT_NE(summary.find("dropped 0 (cobs_error 0"), std::string::npos) << summary;
   EXPECT_NE(summary.find("end of input"), std::string::npos) << summary;
 }
@@ -334,8 +335,8 @@ TEST(telemetry_transport, CountStopsRightAfterTheMessage) {
   const Bytes stream = sample_stream(&messages);
   const test_support::TempDir dir("pliant_telemetry_");
   const std::string path = dir / "capture.bin";
-  std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(stream.data()),
-                                              static_cast<std::streamsize>(stream.size()));
+  std::ofstream(path, std::ios::binary)
+      .write(reinterpret_cast<const char*>(stream.data()), static_cast<std::streamsize>(stream.size()));
   tm::FileSource file(path);
   tm::StreamLimits limits;
   limits.max_messages = 4;
@@ -438,8 +439,8 @@ TEST(telemetry_transport, StopRequestEndsTheStream) {
   tm::UdpSource udp("127.0.0.1", 0);
   const auto start = std::chrono::steady_clock::now();
   const auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
-  const tm::StreamResult r =
-      tm::read_telemetry(udp, {}, [](const pliant_tm_message_t&) {}, [&] { return elapsed() > 0.2; });
+  const tm::StreamResult r = tm::read_telemetry(
+      udp, {}, [](const pliant_tm_message_t&) {}, [&] { return elapsed() > 0.2; });
   EXPECT_EQ(r.end, tm::StreamEnd::stopped);
   EXPECT_LT(elapsed(), 2.0);
 }

@@ -28,7 +28,9 @@ std::uint64_t get_u64(const Bytes& b, std::size_t at) {
   for (int i = 7; i >= 0; --i) v = (v << 8) | b[at + static_cast<std::size_t>(i)];
   return v;
 }
-std::uint32_t get_u32(const Bytes& b, std::size_t at) { return static_cast<std::uint32_t>(get_u64(Bytes{b[at], b[at + 1], b[at + 2], b[at + 3], 0, 0, 0, 0}, 0)); }
+std::uint32_t get_u32(const Bytes& b, std::size_t at) {
+  return static_cast<std::uint32_t>(get_u64(Bytes{b[at], b[at + 1], b[at + 2], b[at + 3], 0, 0, 0, 0}, 0));
+}
 std::uint16_t get_u16(const Bytes& b, std::size_t at) { return static_cast<std::uint16_t>(b[at] | (b[at + 1] << 8)); }
 
 TEST(telemetry_layout, EstimatePacketIsTheDocumentedBytes) {
@@ -68,8 +70,9 @@ TEST(telemetry_layout, VerdictPacketIsTheDocumentedBytes) {
   EXPECT_EQ(get_u32(packet, 16), (1u << 14) | (1u << 12));
   EXPECT_EQ(packet[20], PLIANT_TM_VERDICT_IN_CONTACT);
   EXPECT_EQ((Bytes{packet.begin() + 21, packet.begin() + 24}), (Bytes{0, 0, 0}));
-  const float expected[10] = {v.closure_m, v.force_n, v.strain, v.allowed_force_n, v.predicted_strain,
-                              v.safe_closure_m, v.safe_width_m, v.predicted_force_n, v.beta_low, v.beta_high};
+  const float expected[10] = {v.closure_m,        v.force_n,        v.strain,       v.allowed_force_n,
+                              v.predicted_strain, v.safe_closure_m, v.safe_width_m, v.predicted_force_n,
+                              v.beta_low,         v.beta_high};
   for (std::size_t i = 0; i < 10; ++i) {
     const std::uint32_t bits = get_u32(packet, 24 + 4 * i);
     float value = 0;
@@ -158,12 +161,13 @@ TEST(telemetry_roundtrip, Verdict) {
   EXPECT_EQ(d.verdict.fault_sources, v.fault_sources);
   EXPECT_EQ(d.verdict.reasons, v.reasons);
   EXPECT_EQ(d.verdict.flags, v.flags);
-  const float* const got[10] = {&d.verdict.closure_m, &d.verdict.force_n, &d.verdict.strain,
-                                &d.verdict.allowed_force_n, &d.verdict.predicted_strain, &d.verdict.safe_closure_m,
-                                &d.verdict.safe_width_m, &d.verdict.predicted_force_n, &d.verdict.beta_low,
+  const float* const got[10] = {&d.verdict.closure_m,       &d.verdict.force_n,           &d.verdict.strain,
+                                &d.verdict.allowed_force_n, &d.verdict.predicted_strain,  &d.verdict.safe_closure_m,
+                                &d.verdict.safe_width_m,    &d.verdict.predicted_force_n, &d.verdict.beta_low,
                                 &d.verdict.beta_high};
-  const float want[10] = {v.closure_m, v.force_n, v.strain, v.allowed_force_n, v.predicted_strain,
-                          v.safe_closure_m, v.safe_width_m, v.predicted_force_n, v.beta_low, v.beta_high};
+  const float want[10] = {v.closure_m,        v.force_n,        v.strain,       v.allowed_force_n,
+                          v.predicted_strain, v.safe_closure_m, v.safe_width_m, v.predicted_force_n,
+                          v.beta_low,         v.beta_high};
   for (int i = 0; i < 10; ++i) EXPECT_TRUE(same_bits(*got[i], want[i])) << i;
 }
 
@@ -209,7 +213,8 @@ TEST(telemetry_roundtrip, ParticlesChunkedAtEveryCapacity) {
     ParticleFrame f = make_particle_frame(17, dim, 300);
     f.positions[4] = kNaNf;
     f.positions[7] = kInff;
-    for (std::size_t capacity : {std::size_t{PLIANT_TM_MAX_FRAME}, std::size_t{600}, std::size_t{255}, std::size_t{64}}) {
+    for (std::size_t capacity :
+         {std::size_t{PLIANT_TM_MAX_FRAME}, std::size_t{600}, std::size_t{255}, std::size_t{64}}) {
       pliant_tm_encoder_t enc;
       pliant_tm_encoder_init(&enc, 0);
       const std::vector<Bytes> chunks = particle_chunks(enc, 77, f, capacity);
@@ -393,8 +398,9 @@ TEST(telemetry_encoder, RefusesOutOfRangeFields) {
   EXPECT_EQ(pliant_tm_encode_counters(&enc, 0, nullptr, 1, out.data(), out.size()), PLIANT_TM_E_ARGUMENT);
   std::vector<pliant_tm_counter_t> many(PLIANT_TM_MAX_COUNTERS + 1);
   for (std::size_t i = 0; i < many.size(); ++i) many[i].id = static_cast<std::uint16_t>(i);
-  EXPECT_EQ(pliant_tm_encode_counters(&enc, 0, many.data(), static_cast<std::uint16_t>(many.size()), out.data(), out.size()),
-            PLIANT_TM_E_TOO_LARGE);
+  EXPECT_EQ(
+      pliant_tm_encode_counters(&enc, 0, many.data(), static_cast<std::uint16_t>(many.size()), out.data(), out.size()),
+      PLIANT_TM_E_TOO_LARGE);
   const pliant_tm_estimate_t e = sample_estimate();
   EXPECT_EQ(pliant_tm_encode_estimate(nullptr, 0, &e, out.data(), out.size()), PLIANT_TM_E_ARGUMENT);
   EXPECT_EQ(pliant_tm_encode_estimate(&enc, 0, nullptr, out.data(), out.size()), PLIANT_TM_E_ARGUMENT);

@@ -252,8 +252,10 @@ std::vector<Corruption> corruptions() {
   list.push_back({"verdict_51", crafted_frame(2, 0, Bytes(51, 0)), &C::bad_length});
   list.push_back({"verdict_empty", crafted_frame(2, 0, Bytes{}), &C::bad_length});
   list.push_back({"particles_head_only_short", crafted_frame(3, 0, Bytes(11, 0)), &C::bad_length});
-  list.push_back({"particles_count_says_3_has_2", crafted_frame(3, 0, particles_payload(3, 10, 0, 3, 2)), &C::bad_length});
-  list.push_back({"particles_extra_byte", [] {
+  list.push_back(
+      {"particles_count_says_3_has_2", crafted_frame(3, 0, particles_payload(3, 10, 0, 3, 2)), &C::bad_length});
+  list.push_back({"particles_extra_byte",
+                  [] {
                     Bytes p = particles_payload(2, 10, 0, 1, 1);
                     p.push_back(0);
                     return crafted_frame(3, 0, p);
@@ -264,7 +266,8 @@ std::vector<Corruption> corruptions() {
   // Fields out of range.
   list.push_back({"particles_dim_4", crafted_frame(3, 0, particles_payload(4, 10, 0, 1, 1)), &C::out_of_range});
   list.push_back({"particles_dim_1", crafted_frame(3, 0, particles_payload(1, 10, 0, 0, 0)), &C::out_of_range});
-  list.push_back({"particles_first_plus_count", crafted_frame(3, 0, particles_payload(3, 10, 8, 3, 3)), &C::out_of_range});
+  list.push_back(
+      {"particles_first_plus_count", crafted_frame(3, 0, particles_payload(3, 10, 8, 3, 3)), &C::out_of_range});
   list.push_back({"particles_status_3", crafted_frame(3, 0, particles_payload(2, 10, 0, 2, 2, 3)), &C::out_of_range});
   list.push_back({"verdict_3", crafted_frame(2, 0, verdict_payload(3, 0, 0, 0, 0)), &C::out_of_range});
   list.push_back({"reason_19", crafted_frame(2, 0, verdict_payload(0, 19, 0, 0, 0)), &C::out_of_range});
@@ -281,9 +284,9 @@ std::vector<Corruption> corruptions() {
 
 TEST(telemetry_stream, EveryCorruptionCountedUnderItsReason) {
   using C = pliant_tm_decoder_counters_t;
-  const std::uint32_t C::*const reasons[] = {&C::cobs_error, &C::crc_mismatch, &C::oversize, &C::short_packet,
-                                             &C::version, &C::bad_length, &C::out_of_range, &C::unknown_type,
-                                             &C::truncated};
+  const std::uint32_t C::*const reasons[] = {&C::cobs_error,   &C::crc_mismatch, &C::oversize,
+                                             &C::short_packet, &C::version,      &C::bad_length,
+                                             &C::out_of_range, &C::unknown_type, &C::truncated};
   for (const Corruption& bad : corruptions()) {
     for (const std::vector<std::size_t>& pieces : {std::vector<std::size_t>{}, {1}, {5, 1, 333}}) {
       pliant_tm_encoder_t enc;
@@ -351,9 +354,9 @@ TEST(telemetry_stream, EmitterRestartIsNotALoss) {
 TEST(telemetry_stream, CrcBadPacketsDoNotMoveTheSequence) {
   pliant_tm_encoder_t enc;
   pliant_tm_encoder_init(&enc, 10);
-  Bytes stream = estimate_frame(enc, 0, sample_estimate());  // 10
+  Bytes stream = estimate_frame(enc, 0, sample_estimate());             // 10
   Bytes broken = packet_of(estimate_frame(enc, 0, sample_estimate()));  // 11, CRC broken
-  broken[2] = 200;  // and its seq byte damaged
+  broken[2] = 200;                                                      // and its seq byte damaged
   append(stream, frame_of(broken));
   append(stream, estimate_frame(enc, 0, sample_estimate()));  // 12
   pliant_tm_decoder_t dec;

@@ -94,8 +94,8 @@ inline std::vector<Bytes> particle_chunks(pliant_tm_encoder_t& enc, std::uint64_
   do {
     const auto count = static_cast<std::uint16_t>(std::min<std::uint32_t>(per_chunk, f.total() - first));
     Bytes out(frame_capacity);
-    chunks.push_back(checked(pliant_tm_encode_particles(&enc, stamp_us, &view, static_cast<std::uint16_t>(first),
-                                                        count, out.data(), out.size()),
+    chunks.push_back(checked(pliant_tm_encode_particles(&enc, stamp_us, &view, static_cast<std::uint16_t>(first), count,
+                                                        out.data(), out.size()),
                              out));
     first += count;
   } while (first < f.total());
@@ -225,7 +225,8 @@ inline Decoded own(const pliant_tm_message_t& m) {
       d.particles.items = nullptr;
       break;
     case PLIANT_TM_TYPE_COUNTERS:
-      for (std::uint16_t i = 0; i < m.body.counters.count; ++i) d.counters.push_back(pliant_tm_counters_get(&m.body.counters, i));
+      for (std::uint16_t i = 0; i < m.body.counters.count; ++i)
+        d.counters.push_back(pliant_tm_counters_get(&m.body.counters, i));
       break;
     default: break;
   }

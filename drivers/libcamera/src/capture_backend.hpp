@@ -41,10 +41,10 @@ struct BufferPlanes {
 enum class CompletionStatus : std::uint8_t { success, error, cancelled };
 
 struct Completion {
-  int buffer = -1;                  ///< index of the buffer, 0..buffer_count-1
+  int buffer = -1;  ///< index of the buffer, 0..buffer_count-1
   CompletionStatus status = CompletionStatus::success;
-  std::uint32_t sequence = 0;       ///< the camera's frame sequence number
-  std::uint64_t timestamp_ns = 0;   ///< capture time, CLOCK_MONOTONIC ns (0: unknown)
+  std::uint32_t sequence = 0;          ///< the camera's frame sequence number
+  std::uint64_t timestamp_ns = 0;      ///< capture time, CLOCK_MONOTONIC ns (0: unknown)
   std::size_t bytes_used[2] = {0, 0};  ///< per plane as the camera reports it (0: unknown)
 };
 

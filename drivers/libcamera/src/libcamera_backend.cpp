@@ -67,9 +67,9 @@ RawFormat raw_format_of(const libcamera::PixelFormat& format) {
 }
 
 // The formats this driver converts, best first (no conversion, then cheap ones).
-constexpr RawFormat kPreference[] = {RawFormat::rgb888, RawFormat::bgr888, RawFormat::xrgb8888, RawFormat::xbgr8888,
-                                     RawFormat::yuyv,   RawFormat::uyvy,   RawFormat::nv12,     RawFormat::nv21,
-                                     RawFormat::r8};
+constexpr RawFormat kPreference[] = {RawFormat::rgb888,   RawFormat::bgr888, RawFormat::xrgb8888,
+                                     RawFormat::xbgr8888, RawFormat::yuyv,   RawFormat::uyvy,
+                                     RawFormat::nv12,     RawFormat::nv21,   RawFormat::r8};
 
 class LibcameraBackend final : public CaptureBackend {
  public:
@@ -300,9 +300,9 @@ class LibcameraBackend final : public CaptureBackend {
       c.status = CompletionStatus::cancelled;
     } else {
       const libcamera::FrameMetadata& metadata = buffer->metadata();
-      c.status = metadata.status == libcamera::FrameMetadata::FrameSuccess ? CompletionStatus::success
+      c.status = metadata.status == libcamera::FrameMetadata::FrameSuccess     ? CompletionStatus::success
                  : metadata.status == libcamera::FrameMetadata::FrameCancelled ? CompletionStatus::cancelled
-                                                                                : CompletionStatus::error;
+                                                                               : CompletionStatus::error;
       c.sequence = metadata.sequence;
       c.timestamp_ns = metadata.timestamp;
       const auto used = metadata.planes();

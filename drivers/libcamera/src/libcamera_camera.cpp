@@ -123,8 +123,8 @@ HalStatus LibcameraCamera::on_start() noexcept {
 }
 
 HalStatus LibcameraCamera::on_stop() noexcept {
-  pipeline_->end();   // no requeues from here on
-  backend_->stop();   // completes what is queued (cancelled)
+  pipeline_->end();  // no requeues from here on
+  backend_->stop();  // completes what is queued (cancelled)
   streaming_ = false;
   return HalStatus::ok;
 }

@@ -44,12 +44,8 @@ YuvCoefficients yuv_coefficients(YcbcrMatrix matrix, bool full_range) noexcept {
 // Writes one pixel in the output format; returns the next output position.
 std::uint8_t* put(std::uint8_t* o, hal::PixelFormat format, std::uint8_t r, std::uint8_t g, std::uint8_t b) noexcept {
   switch (format) {
-    case hal::PixelFormat::rgb8:
-      o[0] = r, o[1] = g, o[2] = b;
-      return o + 3;
-    case hal::PixelFormat::bgr8:
-      o[0] = b, o[1] = g, o[2] = r;
-      return o + 3;
+    case hal::PixelFormat::rgb8: o[0] = r, o[1] = g, o[2] = b; return o + 3;
+    case hal::PixelFormat::bgr8: o[0] = b, o[1] = g, o[2] = r; return o + 3;
     case hal::PixelFormat::mono8: {
       // BT.601 luma weights, 16.16 (they sum to 65536).
       const std::int32_t luma = 19595 * r + 38470 * g + 7471 * b + kHalf;
@@ -60,7 +56,8 @@ std::uint8_t* put(std::uint8_t* o, hal::PixelFormat format, std::uint8_t r, std:
   return o;
 }
 
-std::uint8_t* put_yuv(std::uint8_t* o, hal::PixelFormat format, const YuvCoefficients& c, int y, int u, int v) noexcept {
+std::uint8_t* put_yuv(std::uint8_t* o, hal::PixelFormat format, const YuvCoefficients& c, int y, int u,
+                      int v) noexcept {
   const std::int32_t luma = c.y * (y - c.y_offset);
   if (format == hal::PixelFormat::mono8) {
     o[0] = clamp_shift(luma + kHalf);
@@ -93,8 +90,9 @@ bool valid_output(hal::PixelFormat format) noexcept {
 }  // namespace
 
 RawFormat raw_format_from_fourcc(std::uint32_t code) noexcept {
-  constexpr RawFormat all[] = {RawFormat::rgb888, RawFormat::bgr888, RawFormat::xrgb8888, RawFormat::xbgr8888, RawFormat::yuyv,
-                               RawFormat::uyvy,   RawFormat::nv12,   RawFormat::nv21,     RawFormat::r8};
+  constexpr RawFormat all[] = {RawFormat::rgb888,   RawFormat::bgr888, RawFormat::xrgb8888,
+                               RawFormat::xbgr8888, RawFormat::yuyv,   RawFormat::uyvy,
+                               RawFormat::nv12,     RawFormat::nv21,   RawFormat::r8};
   for (const RawFormat format : all) {
     if (raw_format_fourcc(format) == code) return format;
   }
@@ -180,7 +178,8 @@ ConvertStatus convert_raw(const RawImage& in, hal::PixelFormat out_format, std::
   if (in.plane[0] == nullptr || !fits(in.plane_bytes[0], in.stride[0], rows, row)) return ConvertStatus::short_buffer;
   if (semi_planar) {
     if (in.stride[1] < row) return ConvertStatus::bad_geometry;
-    if (in.plane[1] == nullptr || !fits(in.plane_bytes[1], in.stride[1], rows / 2, row)) return ConvertStatus::short_buffer;
+    if (in.plane[1] == nullptr || !fits(in.plane_bytes[1], in.stride[1], rows / 2, row))
+      return ConvertStatus::short_buffer;
   }
   const std::size_t out_row = static_cast<std::size_t>(w) * static_cast<std::size_t>(hal::pixel_bytes(out_format));
   if (out == nullptr || out_stride < out_row || !fits(out_bytes, out_stride, rows, out_row)) {

@@ -11,7 +11,9 @@ namespace {
 
 using hal::HalStatus;
 
-bool is_modbus_exception(int err) noexcept { return err > MODBUS_ENOBASE && err < MODBUS_ENOBASE + MODBUS_EXCEPTION_MAX; }
+bool is_modbus_exception(int err) noexcept {
+  return err > MODBUS_ENOBASE && err < MODBUS_ENOBASE + MODBUS_EXCEPTION_MAX;
+}
 
 // Seconds -> libmodbus's (sec, usec) pair; the caller validated 0 < s <= 10.
 void split_seconds(double s, std::uint32_t& sec, std::uint32_t& usec) noexcept {
@@ -29,8 +31,8 @@ HalStatus validate(const ModbusLinkConfig& c) noexcept {
     return HalStatus::invalid_argument;
   }
   if (c.transport == ModbusTransport::rtu) {
-    if (c.device.empty() || c.baud <= 0 || (c.parity != 'N' && c.parity != 'E' && c.parity != 'O') ||
-        c.data_bits < 5 || c.data_bits > 8 || (c.stop_bits != 1 && c.stop_bits != 2)) {
+    if (c.device.empty() || c.baud <= 0 || (c.parity != 'N' && c.parity != 'E' && c.parity != 'O') || c.data_bits < 5 ||
+        c.data_bits > 8 || (c.stop_bits != 1 && c.stop_bits != 2)) {
       return HalStatus::invalid_argument;
     }
     return HalStatus::ok;
@@ -48,8 +50,7 @@ HalStatus validate(const ModbusLinkConfig& c) noexcept {
 HalStatus modbus_errno_status(int err) noexcept {
   switch (err) {
     case ETIMEDOUT:
-    case EMBXGTAR:
-      return HalStatus::timeout;
+    case EMBXGTAR: return HalStatus::timeout;
     case ECONNRESET:
     case ECONNREFUSED:
     case ECONNABORTED:
@@ -64,12 +65,9 @@ HalStatus modbus_errno_status(int err) noexcept {
     case EHOSTUNREACH:
     case ENETUNREACH:
     case ENETDOWN:
-    case EHOSTDOWN:
-      return HalStatus::disconnected;
-    case EMBXILFUN:
-      return HalStatus::unsupported;
-    default:
-      return HalStatus::io_error;
+    case EHOSTDOWN: return HalStatus::disconnected;
+    case EMBXILFUN: return HalStatus::unsupported;
+    default: return HalStatus::io_error;
   }
 }
 
@@ -91,8 +89,7 @@ HalStatus ModbusLink::open(const ModbusLinkConfig& config) {
   std::uint32_t sec = 0, usec = 0;
   split_seconds(config.response_timeout_s, sec, usec);
   if (modbus_set_slave(ctx_, config.slave_id) != 0 || modbus_set_response_timeout(ctx_, sec, usec) != 0 ||
-      modbus_set_byte_timeout(ctx_, 0, 0) != 0 ||
-      modbus_set_error_recovery(ctx_, MODBUS_ERROR_RECOVERY_NONE) != 0) {
+      modbus_set_byte_timeout(ctx_, 0, 0) != 0 || modbus_set_error_recovery(ctx_, MODBUS_ERROR_RECOVERY_NONE) != 0) {
     close();
     return HalStatus::invalid_argument;
   }
@@ -159,9 +156,7 @@ HalStatus ModbusLink::fail(int err) noexcept {
       modbus_close(ctx_);
       last_attempt_s_ = clock_.now_s();
       break;
-    case HalStatus::unsupported:
-      ++counters_.exceptions;
-      break;
+    case HalStatus::unsupported: ++counters_.exceptions; break;
     default:
       if (is_modbus_exception(err)) {
         ++counters_.exceptions;

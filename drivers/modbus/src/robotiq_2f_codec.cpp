@@ -110,7 +110,7 @@ std::uint8_t width_to_position(double width_m, const Scaling& c) noexcept {
   const double closed = static_cast<double>(c.closed_byte);
   const double open = static_cast<double>(c.open_byte);
   const double p = closed - (closed - open) * (w / c.stroke_m);  // between open and closed
-  if (!std::isfinite(p)) return c.open_byte;  // an infinite stroke (invalid scaling)
+  if (!std::isfinite(p)) return c.open_byte;                     // an infinite stroke (invalid scaling)
   const long r = std::lround(p);
   if (r < 0) return 0;
   if (r > 255) return 255;

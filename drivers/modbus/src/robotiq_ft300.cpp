@@ -28,8 +28,8 @@ RobotiqFt300::~RobotiqFt300() { close_port(); }
 HalStatus RobotiqFt300::on_configure() {
   const RobotiqFt300Config& c = config_;
   if (validate(c.link) != HalStatus::ok || !finite_non_negative(c.min_poll_period_s) ||
-      !(std::isfinite(c.stream_timeout_s) && c.stream_timeout_s > 0) || c.max_stream_bytes_per_read < ft300::kFrameSize ||
-      c.max_stream_bytes_per_read > 65536) {
+      !(std::isfinite(c.stream_timeout_s) && c.stream_timeout_s > 0) ||
+      c.max_stream_bytes_per_read < ft300::kFrameSize || c.max_stream_bytes_per_read > 65536) {
     return HalStatus::invalid_argument;
   }
   close_port();

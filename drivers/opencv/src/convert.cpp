@@ -11,10 +11,8 @@ namespace {
 // The cvtColor code from `channels` (1, 3, 4) to `format`; -1 for a plain copy.
 int conversion_code(int channels, hal::PixelFormat format) noexcept {
   switch (format) {
-    case hal::PixelFormat::mono8:
-      return channels == 1 ? -1 : channels == 3 ? cv::COLOR_BGR2GRAY : cv::COLOR_BGRA2GRAY;
-    case hal::PixelFormat::bgr8:
-      return channels == 1 ? cv::COLOR_GRAY2BGR : channels == 3 ? -1 : cv::COLOR_BGRA2BGR;
+    case hal::PixelFormat::mono8: return channels == 1 ? -1 : channels == 3 ? cv::COLOR_BGR2GRAY : cv::COLOR_BGRA2GRAY;
+    case hal::PixelFormat::bgr8: return channels == 1 ? cv::COLOR_GRAY2BGR : channels == 3 ? -1 : cv::COLOR_BGRA2BGR;
     case hal::PixelFormat::rgb8:
       return channels == 1 ? cv::COLOR_GRAY2RGB : channels == 3 ? cv::COLOR_BGR2RGB : cv::COLOR_BGRA2RGB;
   }

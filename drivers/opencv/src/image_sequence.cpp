@@ -9,9 +9,7 @@ namespace {
 
 bool is_digit(char c) noexcept { return c >= '0' && c <= '9'; }
 
-char lower(char c) noexcept {
-  return (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c;
-}
+char lower(char c) noexcept { return (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c; }
 
 }  // namespace
 
@@ -117,8 +115,8 @@ bool natural_less(std::string_view a, std::string_view b) noexcept {
 }
 
 bool has_image_extension(std::string_view name) noexcept {
-  static constexpr std::string_view kExtensions[] = {"png", "jpg", "jpeg", "bmp", "tif", "tiff", "pbm",
-                                                     "pgm", "ppm", "pnm", "webp", "exr", "hdr"};
+  static constexpr std::string_view kExtensions[] = {"png", "jpg", "jpeg", "bmp",  "tif", "tiff", "pbm",
+                                                     "pgm", "ppm", "pnm",  "webp", "exr", "hdr"};
   const std::size_t dot = name.rfind('.');
   if (dot == std::string_view::npos || dot + 1 >= name.size()) return false;
   const std::string_view ext = name.substr(dot + 1);

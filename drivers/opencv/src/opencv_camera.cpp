@@ -34,6 +34,9 @@ constexpr double kDueTolerance_s = 1e-9;
 constexpr auto kIdlePoll = std::chrono::milliseconds(2);
 constexpr double kFirstFrameWait_s = 5.0;  // a non-blocking source's first frame, at configure
 
+// Real time, for what the injected Clock cannot measure: the age of a grabbed frame (the grab
+// thread must not read the Clock; see the header) and the real-time caps of blocking waits (a
+// ManualClock does not move while its only thread is blocked here).
 double steady_now_s() noexcept {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
@@ -113,7 +116,7 @@ struct OpenCvCamera::Impl {
   cv::Mat image;
   cv::Mat scratch;
   std::uint64_t next_sequence = 1;
-  double next_attempt_s = 0;  ///< steady time of the next reopen attempt
+  std::uint64_t reopens_served = 0;  ///< reopen requests this thread has acted on
   std::thread thread;
 
   // ---- shared
@@ -129,12 +132,20 @@ struct OpenCvCamera::Impl {
   std::atomic<std::uint64_t> skipped{0};
   std::atomic<std::uint64_t> reconnect_attempts{0};
   std::atomic<std::uint64_t> reopened{0};
+  // Devices: reopen attempts are timed by read() on the injected Clock and run by the grab
+  // thread (which never reads the Clock): read() raises `reopen_requests`, the thread answers
+  // by raising `reopens_done` to it once the attempt is over.
+  std::atomic<std::uint64_t> reopen_requests{0};
+  std::atomic<std::uint64_t> reopens_done{0};
 
   // ---- consumer side (the thread that drives the device)
   bool holding = false;  ///< the slot at the ring's tail was delivered by the last read
   bool anchored = false;
-  double anchor_s = 0;   ///< clock time at which media time first_media_s is due
+  double anchor_s = 0;  ///< clock time at which media time first_media_s is due
   double paused_at_s = kNaN;
+  bool loss_noted = false;          ///< devices: read() saw the current loss
+  double next_attempt_s = 0;        ///< devices: clock time from which read() asks for a reopen
+  std::uint64_t reopens_asked = 0;  ///< devices: reopen_requests as this side last raised it
 
   std::size_t buffered() const noexcept {
     const std::uint64_t pending = ring.head() - ring.tail();
@@ -206,10 +217,14 @@ struct OpenCvCamera::Impl {
 
   void sleep_idle() const { std::this_thread::sleep_for(kIdlePoll); }
 
-  // Devices: waits for the next attempt time, then tries to reopen.
-  void try_reopen() {
-    while (!quit.load(std::memory_order_relaxed) && steady_now_s() < next_attempt_s) sleep_idle();
-    if (quit.load(std::memory_order_relaxed)) return;
+  // Devices (grab thread): one reopen attempt when read() asked for one, else a short sleep.
+  void serve_reopen() {
+    const std::uint64_t asked = reopen_requests.load(std::memory_order_acquire);
+    if (asked == reopens_served) {
+      sleep_idle();
+      return;
+    }
+    reopens_served = asked;
     bump(reconnect_attempts);
     opencv_detail::OpenError error;
     try {
@@ -220,9 +235,24 @@ struct OpenCvCamera::Impl {
     if (source) {
       bump(reopened);
       lost.store(false, std::memory_order_release);
-    } else {
-      next_attempt_s = steady_now_s() + reconnect_interval_s;
     }
+    reopens_done.store(asked, std::memory_order_release);
+  }
+
+  // Devices (read(), the driving thread): paces reopen attempts on the injected Clock while the
+  // device is lost. The first attempt is due reconnect_interval_s after the read that saw the
+  // loss, each next one reconnect_interval_s after the read that asked for the previous one
+  // (later while that attempt is still running).
+  void pace_reopen(double now_s) noexcept {
+    if (!loss_noted) {
+      loss_noted = true;
+      next_attempt_s = now_s + reconnect_interval_s;
+      return;
+    }
+    if (now_s < next_attempt_s) return;
+    if (reopens_done.load(std::memory_order_acquire) != reopens_asked) return;  // still running
+    reopen_requests.store(++reopens_asked, std::memory_order_release);
+    next_attempt_s = now_s + reconnect_interval_s;
   }
 
   void run() noexcept {
@@ -230,14 +260,13 @@ struct OpenCvCamera::Impl {
       while (!quit.load(std::memory_order_relaxed)) {
         if (live) {
           if (!source) {
-            try_reopen();
+            serve_reopen();
             continue;
           }
           const Step step = produce_one();
           if (step == Step::lost) {
             source.reset();
             lost.store(true, std::memory_order_release);
-            next_attempt_s = steady_now_s() + reconnect_interval_s;
           } else if (step == Step::idle) {
             sleep_idle();
           }
@@ -297,11 +326,13 @@ bool OpenCvCamera::end_of_stream() const noexcept {
 bool OpenCvCamera::wait_buffered(int frames, double timeout_s) const noexcept {
   if (!impl_ || impl_->stepped) return true;
   const std::size_t wanted = frames > 0 ? static_cast<std::size_t>(frames) : 0u;
-  const double deadline = steady_now_s() + (std::isfinite(timeout_s) ? timeout_s : 0.0);
+  const double budget_s = std::isfinite(timeout_s) && timeout_s > 0 ? timeout_s : 0.0;
+  const double deadline_s = clock_.now_s() + budget_s;
+  const double real_deadline_s = steady_now_s() + budget_s;
   for (;;) {
     const bool done = impl_->ended.load(std::memory_order_acquire) || impl_->lost.load(std::memory_order_acquire);
     if (done || impl_->buffered() >= wanted) return true;
-    if (steady_now_s() >= deadline) return false;
+    if (clock_.now_s() >= deadline_s || steady_now_s() >= real_deadline_s) return false;
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
 }
@@ -328,9 +359,11 @@ HalStatus OpenCvCamera::on_configure() {
     }
     // The first frame fixes the size of every slot.
     double media_s = kNaN;
+    const double give_up_s = clock_.now_s() + kFirstFrameWait_s;
+    const double real_give_up_s = steady_now_s() + kFirstFrameWait_s;
     SourceStatus first = m.source->next(m.image, media_s);
-    for (const double give_up = steady_now_s() + kFirstFrameWait_s; first == SourceStatus::idle;) {
-      if (steady_now_s() > give_up) {
+    while (first == SourceStatus::idle) {
+      if (clock_.now_s() > give_up_s || steady_now_s() > real_give_up_s) {
         last_error_ = config_.location + ": no first frame within 5 s";
         return HalStatus::timeout;
       }
@@ -342,8 +375,8 @@ HalStatus OpenCvCamera::on_configure() {
         last_error_ = config_.location + ": the device opened but delivered no frame";
         return HalStatus::disconnected;
       }
-      last_error_ = config_.location + (first == SourceStatus::decode_error ? ": the first frame cannot be decoded"
-                                                                            : ": no frame at all");
+      last_error_ = config_.location +
+                    (first == SourceStatus::decode_error ? ": the first frame cannot be decoded" : ": no frame at all");
       return HalStatus::io_error;
     }
     m.width = m.image.cols;
@@ -440,8 +473,10 @@ HalStatus OpenCvCamera::on_read(hal::ColorFrame& out) noexcept {
       const std::uint64_t head = m.ring.head();
       bump(m.skipped, head - tail);
       m.ring.release_to(head);
+      m.pace_reopen(clock_.now_s());
       return HalStatus::disconnected;
     }
+    m.loss_noted = false;
     const std::uint64_t head = m.ring.head();
     if (head == tail) return HalStatus::no_data;
     pick = head - 1;  // the newest

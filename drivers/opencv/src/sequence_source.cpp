@@ -110,7 +110,8 @@ class SequenceFactory final : public SourceFactory {
       error.message = "image directory " + location_ + ": no image files";
       return nullptr;
     }
-    std::sort(names.begin(), names.end(), [](const std::string& a, const std::string& b) { return natural_less(a, b); });
+    std::sort(names.begin(), names.end(),
+              [](const std::string& a, const std::string& b) { return natural_less(a, b); });
     std::vector<std::string> files;
     files.reserve(names.size());
     for (const std::string& name : names) files.push_back((fs::path(location_) / name).string());

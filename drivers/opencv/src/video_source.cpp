@@ -31,7 +31,7 @@ class VideoFileSource final : public FrameSource {
       // Container frame counts may be estimates from the duration: a one-frame shortfall is
       // not reported.
       return (announced_ > 0 && static_cast<double>(frames_) + 1 < announced_) ? SourceStatus::ended_early
-                                                                              : SourceStatus::end;
+                                                                               : SourceStatus::end;
     }
     ++frames_;
     // The backend's position after a read is the frame's presentation time; use it while it
@@ -86,8 +86,7 @@ class VideoFileFactory final : public SourceFactory {
     double fps = capture.get(cv::CAP_PROP_FPS);
     if (!std::isfinite(fps) || fps <= 0 || fps > 1000) fps = fallback_fps_;
     const double announced = capture.get(cv::CAP_PROP_FRAME_COUNT);
-    return std::make_unique<VideoFileSource>(std::move(capture), fps,
-                                             std::isfinite(announced) ? announced : 0.0);
+    return std::make_unique<VideoFileSource>(std::move(capture), fps, std::isfinite(announced) ? announced : 0.0);
   }
 
  private:
@@ -129,7 +128,8 @@ class DeviceFactory final : public SourceFactory {
         return nullptr;
       }
       if (!capture.open(config_.location, cv::CAP_V4L2)) {
-        error.message = "V4L2 device " + config_.location + ": cannot open (not a capture device, busy, or permissions)";
+        error.message =
+            "V4L2 device " + config_.location + ": cannot open (not a capture device, busy, or permissions)";
         return nullptr;
       }
     }

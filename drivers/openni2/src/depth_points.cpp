@@ -173,8 +173,8 @@ PointsResult depth_to_points(const hal::DepthFrame& frame, double* out_xyz, std:
                       frame.depth_scale_m, k, out_xyz, out_capacity_points);
 }
 
-bool copy_depth_image(const std::uint8_t* src, std::size_t src_bytes, int width, int height,
-                      std::size_t stride_bytes, std::uint16_t* dst, std::size_t dst_capacity) noexcept {
+bool copy_depth_image(const std::uint8_t* src, std::size_t src_bytes, int width, int height, std::size_t stride_bytes,
+                      std::uint16_t* dst, std::size_t dst_capacity) noexcept {
   PointsStatus status = PointsStatus::ok;
   if (src == nullptr || dst == nullptr || !layout_ok(src_bytes, width, height, stride_bytes, status)) return false;
   const std::size_t w = static_cast<std::size_t>(width);

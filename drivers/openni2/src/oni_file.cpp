@@ -43,11 +43,12 @@ std::uint64_t le64(const std::uint8_t* p) noexcept {
 }
 
 // Versions compare as (major, minor, maintenance, build), like the player does.
-std::uint64_t version_key(std::uint8_t major, std::uint8_t minor, std::uint16_t maintenance, std::uint32_t build) noexcept {
+std::uint64_t version_key(std::uint8_t major, std::uint8_t minor, std::uint16_t maintenance,
+                          std::uint32_t build) noexcept {
   return static_cast<std::uint64_t>(major) << 56 | static_cast<std::uint64_t>(minor) << 48 |
          static_cast<std::uint64_t>(maintenance) << 32 | build;
 }
-constexpr std::uint64_t kOldestVersion = std::uint64_t{1} << 56 | 4;              // 1.0.0.4
+constexpr std::uint64_t kOldestVersion = std::uint64_t{1} << 56 | 4;                           // 1.0.0.4
 constexpr std::uint64_t kWideHeaderVersion = std::uint64_t{1} << 56 | std::uint64_t{1} << 32;  // 1.0.1.0
 
 // Bounded reading of one record's fields.
@@ -98,11 +99,13 @@ class Walker {
     const std::uint64_t size = source_.size();
     info_.file_bytes = size;
     if (size < kFileHeaderBytes) {
-      return fail(OniCheck::too_short, 0, "file of " + std::to_string(size) + " bytes is shorter than the 24-byte .oni header");
+      return fail(OniCheck::too_short, 0,
+                  "file of " + std::to_string(size) + " bytes is shorter than the 24-byte .oni header");
     }
     std::uint8_t header[kFileHeaderBytes];
     if (!source_.read(0, header, sizeof header)) return fail(OniCheck::io_error, 0, "cannot read the file header");
-    if (std::memcmp(header, "NI10", 4) != 0) return fail(OniCheck::bad_magic, 0, "not an .oni recording (no \"NI10\" magic)");
+    if (std::memcmp(header, "NI10", 4) != 0)
+      return fail(OniCheck::bad_magic, 0, "not an .oni recording (no \"NI10\" magic)");
     info_.version_major = header[4];
     info_.version_minor = header[5];
     info_.version_maintenance = static_cast<std::uint16_t>(header[6] | header[7] << 8);
@@ -113,15 +116,16 @@ class Walker {
         version_key(info_.version_major, info_.version_minor, info_.version_maintenance, info_.version_build);
     if (version < kOldestVersion || version > kWideHeaderVersion) {
       return fail(OniCheck::unsupported_version, 4,
-                  "file format version " + std::to_string(info_.version_major) + "." + std::to_string(info_.version_minor) +
-                      "." + std::to_string(info_.version_maintenance) + "." + std::to_string(info_.version_build) +
-                      " is outside the supported 1.0.0.4 .. 1.0.1.0");
+                  "file format version " + std::to_string(info_.version_major) + "." +
+                      std::to_string(info_.version_minor) + "." + std::to_string(info_.version_maintenance) + "." +
+                      std::to_string(info_.version_build) + " is outside the supported 1.0.0.4 .. 1.0.1.0");
     }
     wide_ = version >= kWideHeaderVersion;
     header_bytes_ = wide_ ? 28 : 24;
     if (info_.max_node_id >= kOniMaxNodes) {
-      return fail(OniCheck::bad_node_count, 20,
-                  "largest node id " + std::to_string(info_.max_node_id) + " is not below " + std::to_string(kOniMaxNodes));
+      return fail(
+          OniCheck::bad_node_count, 20,
+          "largest node id " + std::to_string(info_.max_node_id) + " is not below " + std::to_string(kOniMaxNodes));
     }
     nodes_.assign(static_cast<std::size_t>(info_.max_node_id) + 1, NodeState{});
 
@@ -136,7 +140,8 @@ class Walker {
 
     for (const OniNodeInfo& node : info_.nodes) {
       if (node.seek_table_offset == 0) continue;
-      const auto match = std::find(seek_tables_.begin(), seek_tables_.end(), std::make_pair(node.id, node.seek_table_offset));
+      const auto match =
+          std::find(seek_tables_.begin(), seek_tables_.end(), std::make_pair(node.id, node.seek_table_offset));
       if (match == seek_tables_.end()) {
         return fail(OniCheck::bad_position, nodes_[node.id].added_at,
                     "node \"" + node.name + "\" names a seek table at byte " + std::to_string(node.seek_table_offset) +
@@ -157,12 +162,14 @@ class Walker {
   }
 
   OniCheckResult fail_record(OniCheck status, std::uint64_t offset, const std::string& what) const {
-    return fail(status, offset, "record " + std::to_string(info_.records + 1) + " at byte " + std::to_string(offset) + ": " + what);
+    return fail(status, offset,
+                "record " + std::to_string(info_.records + 1) + " at byte " + std::to_string(offset) + ": " + what);
   }
 
   // One record at `offset`; advances `offset` past it.
   OniCheckResult record(std::uint64_t& offset, std::uint64_t size) {
-    if (size - offset < header_bytes_) return fail_record(OniCheck::truncated, offset, "header cut off by the end of the file");
+    if (size - offset < header_bytes_)
+      return fail_record(OniCheck::truncated, offset, "header cut off by the end of the file");
     std::uint8_t header[28];
     if (!source_.read(offset, header, header_bytes_)) return fail_record(OniCheck::io_error, offset, "read failed");
     const std::uint32_t magic = le32(header);
@@ -172,26 +179,33 @@ class Walker {
     const std::uint32_t payload_size = le32(header + 16);
     const std::uint64_t undo = wide_ ? le64(header + 20) : le32(header + 20);
     if (magic != kRecordMagic) return fail_record(OniCheck::bad_record, offset, "no \"NIR\" record magic");
-    if (!known_type(type)) return fail_record(OniCheck::bad_record, offset, "unknown record type " + std::to_string(type));
-    if (fields_size < header_bytes_) return fail_record(OniCheck::bad_record, offset, "fields size smaller than the record header");
+    if (!known_type(type))
+      return fail_record(OniCheck::bad_record, offset, "unknown record type " + std::to_string(type));
+    if (fields_size < header_bytes_)
+      return fail_record(OniCheck::bad_record, offset, "fields size smaller than the record header");
     const std::uint64_t total = std::uint64_t{fields_size} + payload_size;
     if (total > kOniRecordMaxBytes) {
-      return fail_record(OniCheck::bad_record, offset,
-                         std::to_string(total) + " bytes exceed the player's record buffer of " + std::to_string(kOniRecordMaxBytes));
+      return fail_record(
+          OniCheck::bad_record, offset,
+          std::to_string(total) + " bytes exceed the player's record buffer of " + std::to_string(kOniRecordMaxBytes));
     }
     if (total > size - offset) {
-      return fail_record(OniCheck::truncated, offset,
-                         "needs " + std::to_string(total) + " bytes, the file has " + std::to_string(size - offset) + " left");
+      return fail_record(
+          OniCheck::truncated, offset,
+          "needs " + std::to_string(total) + " bytes, the file has " + std::to_string(size - offset) + " left");
     }
     if (payload_size != 0 && type != kNewData && type != kSeekTable) {
-      return fail_record(OniCheck::bad_record, offset, "payload on a record type " + std::to_string(type) + " that has none");
+      return fail_record(OniCheck::bad_record, offset,
+                         "payload on a record type " + std::to_string(type) + " that has none");
     }
     if (undo != 0 && (undo >= offset || !std::binary_search(record_offsets_.begin(), record_offsets_.end(), undo))) {
-      return fail_record(OniCheck::bad_position, offset, "undo position " + std::to_string(undo) + " is not an earlier record");
+      return fail_record(OniCheck::bad_position, offset,
+                         "undo position " + std::to_string(undo) + " is not an earlier record");
     }
     if (type != kEnd && node_id >= nodes_.size()) {
-      return fail_record(OniCheck::bad_node, offset,
-                         "node id " + std::to_string(node_id) + " above the header's largest " + std::to_string(info_.max_node_id));
+      return fail_record(
+          OniCheck::bad_node, offset,
+          "node id " + std::to_string(node_id) + " above the header's largest " + std::to_string(info_.max_node_id));
     }
     if (info_.records + 1 > kOniMaxRecords) return fail_record(OniCheck::too_many_records, offset, "too many records");
 
@@ -251,9 +265,11 @@ class Walker {
           if (!in.u32(node.frames_declared) || !in.u64(min_ts) || !in.u64(max_ts)) return short_fields("a node");
         }
         if (type == kNodeAdded && !in.u64(node.seek_table_offset)) return short_fields("a node");
-        if (node.frames_declared > kOniMaxFrames) return fail_record(OniCheck::bad_frame, offset, "declared frame count too large");
+        if (node.frames_declared > kOniMaxFrames)
+          return fail_record(OniCheck::bad_frame, offset, "declared frame count too large");
         NodeState& state = nodes_[node_id];
-        if (state.active) return fail_record(OniCheck::bad_node, offset, "node " + std::to_string(node_id) + " added twice");
+        if (state.active)
+          return fail_record(OniCheck::bad_node, offset, "node " + std::to_string(node_id) + " added twice");
         if (state.ever_added) {
           // Added again after a removal: the same node, continue its bookkeeping.
           OniNodeInfo& known = info_.nodes[state.index];
@@ -274,7 +290,8 @@ class Walker {
       case kRealProperty:
       case kStringProperty:
       case kGeneralProperty: {
-        if (active_node(node_id) == nullptr) return fail_record(OniCheck::bad_node, offset, "property of an unknown node");
+        if (active_node(node_id) == nullptr)
+          return fail_record(OniCheck::bad_node, offset, "property of an unknown node");
         std::string name;
         if (!string(in, true, name)) return fail_record(OniCheck::bad_string, offset, "bad property name");
         std::uint32_t data_size = 0;
@@ -284,16 +301,20 @@ class Walker {
         }
         if (type == kStringProperty) {
           const std::uint8_t* value = in.here();
-          if (data_size == 0 || value[data_size - 1] != 0 || std::memchr(value, 0, data_size) != value + data_size - 1) {
-            return fail_record(OniCheck::bad_string, offset, "property \"" + name + "\" is not one NUL-terminated string");
+          if (data_size == 0 || value[data_size - 1] != 0 ||
+              std::memchr(value, 0, data_size) != value + data_size - 1) {
+            return fail_record(OniCheck::bad_string, offset,
+                               "property \"" + name + "\" is not one NUL-terminated string");
           }
         }
         if (type == kGeneralProperty) {
           if (name == "xnFOV" && data_size != 16) {
-            return fail_record(OniCheck::bad_record, offset, "field of view of " + std::to_string(data_size) + " bytes, not 16");
+            return fail_record(OniCheck::bad_record, offset,
+                               "field of view of " + std::to_string(data_size) + " bytes, not 16");
           }
           if (name == "xnMapOutputMode" && data_size < 12) {
-            return fail_record(OniCheck::bad_record, offset, "output mode of " + std::to_string(data_size) + " bytes, under 12");
+            return fail_record(OniCheck::bad_record, offset,
+                               "output mode of " + std::to_string(data_size) + " bytes, under 12");
           }
         }
         return {};
@@ -326,7 +347,8 @@ class Walker {
         if (frame == 0 || frame > info.frames_declared || (node->has_data && frame <= node->last_frame)) {
           return fail_record(OniCheck::bad_frame, offset,
                              "frame number " + std::to_string(frame) + " of node \"" + info.name + "\" (previous " +
-                                 std::to_string(node->last_frame) + ", declared " + std::to_string(info.frames_declared) + ")");
+                                 std::to_string(node->last_frame) + ", declared " +
+                                 std::to_string(info.frames_declared) + ")");
         }
         if (timestamp > info_.max_timestamp_us) {
           return fail_record(OniCheck::bad_timestamp, offset,
@@ -351,7 +373,8 @@ class Walker {
         return {};
       }
       case kSeekTable: {
-        if (!nodes_[node_id].ever_added) return fail_record(OniCheck::bad_node, offset, "seek table of an unknown node");
+        if (!nodes_[node_id].ever_added)
+          return fail_record(OniCheck::bad_node, offset, "seek table of an unknown node");
         const OniNodeInfo& info = info_.nodes[nodes_[node_id].index];
         const std::uint64_t entry = wide_ ? 20 : 16;
         if (payload_size != (std::uint64_t{info.frames_declared} + 1) * entry) {
@@ -362,10 +385,8 @@ class Walker {
         seek_tables_.emplace_back(node_id, offset);
         return {};
       }
-      case kEnd:
-        return {};
-      default:
-        return fail_record(OniCheck::bad_record, offset, "unknown record type");
+      case kEnd: return {};
+      default: return fail_record(OniCheck::bad_record, offset, "unknown record type");
     }
   }
 

@@ -18,6 +18,8 @@ using hal::HalStatus;
 
 namespace {
 
+// Real time, only for the teardown grace: it waits for OpenNI2's own threads, which run in real
+// time whatever the injected Clock says. Every stream timeout reads the injected Clock.
 using SteadyTime = std::chrono::steady_clock::time_point;
 
 double seconds_since(SteadyTime then, SteadyTime now) noexcept {
@@ -59,7 +61,7 @@ struct Openni2Camera::Impl {
   bool stream_running = false;
   bool recording = false;
   bool stepped = false;
-  bool dummy = false;                  // Debian's DummyDevice (see on_stop)
+  bool dummy = false;  // Debian's DummyDevice (see on_stop)
   std::uint64_t received_at_start = 0;
   openni::PixelFormat format = openni::PIXEL_FORMAT_DEPTH_1_MM;
   double depth_scale_m = 1e-3;
@@ -69,17 +71,19 @@ struct Openni2Camera::Impl {
   std::vector<std::uint16_t> image;
   std::uint32_t last_frame_number = 0;  // recordings: the depth node's last frame number
   double stall_timeout_s = 0;
-  int step_timeout_ms = 0;
+  double step_timeout_s = 0;
 
   // Stream state.
   Openni2CameraStats stats;
   SteadyTime stopped_at{};
   bool ever_stopped = false;
-  SteadyTime last_progress{};
+  double last_progress_s = 0;    // clock at the start or the last frame taken
+  bool step_waiting = false;     // stepped: a read found no frame and none came since
+  double step_wait_since_s = 0;  // clock at the read that began that wait
   // Stepped stamps.
   bool have_anchor = false;
-  double anchor_s = 0;           // clock at the first start
-  double paused_s = 0;           // clock time spent stopped since
+  double anchor_s = 0;  // clock at the first start
+  double paused_s = 0;  // clock time spent stopped since
   double clock_at_stop_s = 0;
   bool have_first_ts = false;
   std::uint64_t first_ts_us = 0;
@@ -88,7 +92,7 @@ struct Openni2Camera::Impl {
   double offset_s = 0;
   // Sequence numbers.
   bool have_index = false;
-  std::int64_t index_base = 0;   // sequence = index - index_base
+  std::int64_t index_base = 0;  // sequence = index - index_base
   std::uint64_t last_sequence = 0;
 
   DepthIntrinsics no_intrinsics;
@@ -177,8 +181,8 @@ HalStatus Openni2Camera::configure_impl() {
     return invalid("stepped playback is for recordings only");
   }
   const DepthIntrinsics& fallback = c.fallback_intrinsics;
-  const bool has_fallback = !(std::isnan(fallback.fx) && std::isnan(fallback.fy) && std::isnan(fallback.cx) &&
-                              std::isnan(fallback.cy));
+  const bool has_fallback =
+      !(std::isnan(fallback.fx) && std::isnan(fallback.fy) && std::isnan(fallback.cx) && std::isnan(fallback.cy));
   if (has_fallback && check_intrinsics(fallback) != IntrinsicsCheck::ok) {
     return invalid(std::string("fallback_intrinsics: ") + intrinsics_check_name(check_intrinsics(fallback)));
   }
@@ -187,7 +191,7 @@ HalStatus Openni2Camera::configure_impl() {
   Impl& m = *impl_;
   m.recording = c.source == Openni2Source::recording;
   m.stepped = m.recording && c.playback == Openni2Playback::stepped;
-  m.step_timeout_ms = static_cast<int>(std::ceil(c.step_timeout_s * 1000));
+  m.step_timeout_s = c.step_timeout_s;
 
   std::string uri;
   const OniNodeInfo* depth_node = nullptr;
@@ -245,7 +249,8 @@ HalStatus Openni2Camera::configure_impl() {
   m.device_open = true;
   m.dummy = !m.recording && is_dummy_uri(uri.c_str());
   if (m.device.isFile() != m.recording) {
-    last_error_ = m.recording ? "\"" + uri + "\" did not open as a recording" : "\"" + uri + "\" is a recording, not a device";
+    last_error_ =
+        m.recording ? "\"" + uri + "\" did not open as a recording" : "\"" + uri + "\" is a recording, not a device";
     return HalStatus::invalid_argument;
   }
   m.events = std::make_unique<detail::DeviceEvents>(m.device.getDeviceInfo().getUri());
@@ -264,7 +269,8 @@ HalStatus Openni2Camera::configure_impl() {
     }
   }
 
-  if (m.device.getSensorInfo(openni::SENSOR_DEPTH) == nullptr || m.stream.create(m.device, openni::SENSOR_DEPTH) != openni::STATUS_OK) {
+  if (m.device.getSensorInfo(openni::SENSOR_DEPTH) == nullptr ||
+      m.stream.create(m.device, openni::SENSOR_DEPTH) != openni::STATUS_OK) {
     last_error_ = "\"" + uri + "\" has no depth sensor: " + extended_error();
     return HalStatus::unsupported;
   }
@@ -324,13 +330,15 @@ HalStatus Openni2Camera::configure_impl() {
   m.stats.hfov_rad = has_h ? static_cast<double>(hfov) : std::numeric_limits<double>::quiet_NaN();
   m.stats.vfov_rad = has_v ? static_cast<double>(vfov) : std::numeric_limits<double>::quiet_NaN();
   DepthIntrinsics from_fov;
-  if (has_h && has_v && intrinsics_from_fov(m.stats.hfov_rad, m.stats.vfov_rad, m.width, m.height, from_fov) == IntrinsicsCheck::ok) {
+  if (has_h && has_v &&
+      intrinsics_from_fov(m.stats.hfov_rad, m.stats.vfov_rad, m.width, m.height, from_fov) == IntrinsicsCheck::ok) {
     m.intrinsics = from_fov;
     m.stats.intrinsics_source = IntrinsicsSource::device_fov;
   } else if (has_fallback) {
     if (fallback.width != m.width || fallback.height != m.height) {
-      return invalid("fallback_intrinsics are for " + std::to_string(fallback.width) + "x" + std::to_string(fallback.height) +
-                     ", the stream is " + std::to_string(m.width) + "x" + std::to_string(m.height));
+      return invalid("fallback_intrinsics are for " + std::to_string(fallback.width) + "x" +
+                     std::to_string(fallback.height) + ", the stream is " + std::to_string(m.width) + "x" +
+                     std::to_string(m.height));
     }
     m.intrinsics = fallback;
     m.stats.intrinsics_source = IntrinsicsSource::configured;
@@ -368,7 +376,8 @@ HalStatus Openni2Camera::on_start() noexcept {
   }
   m.have_offset = false;  // a pause would otherwise count as transport delay
   m.received_at_start = m.stats.received;
-  m.last_progress = std::chrono::steady_clock::now();
+  m.last_progress_s = now_s;
+  m.step_waiting = false;  // time spent stopped is no wait for the player
   return HalStatus::ok;
 }
 
@@ -412,21 +421,35 @@ HalStatus Openni2Camera::on_read(hal::DepthFrame& out) noexcept {
   const bool end_of_file = m.recording && m.events->end_of_file();
   openni::VideoStream* streams[1] = {&m.stream};
   int ready = -1;
-  const int timeout_ms = (m.stepped && !end_of_file) ? m.step_timeout_ms : 0;
+  int timeout_ms = 0;
+  if (m.stepped && !end_of_file) {
+    // Block for what is left of step_timeout_s on the injected Clock, but never longer than
+    // step_timeout_s of real time: a ManualClock does not move while we block, so its caller
+    // sees no_data and advances it (header). The extra millisecond lets a real clock pass the
+    // deadline within this read despite the millisecond rounding of the wait.
+    const double now_s = clock_.now_s();
+    if (!m.step_waiting) {
+      m.step_waiting = true;
+      m.step_wait_since_s = now_s;
+    }
+    const double left_s = std::min(m.step_wait_since_s + m.step_timeout_s - now_s, m.step_timeout_s);
+    if (left_s > 0) timeout_ms = static_cast<int>(std::ceil(left_s * 1000)) + 1;
+  }
   const openni::Status waited = openni::OpenNI::waitForAnyStream(streams, 1, &ready, timeout_ms);
   if (waited == openni::STATUS_TIME_OUT) {
     if (m.recording) {
-      const double silent_s = seconds_since(m.last_progress, std::chrono::steady_clock::now());
-      if (end_of_file || m.stepped || silent_s > m.stall_timeout_s) {
-        end_stream(m.stats.last_frame_index < static_cast<int>(m.last_frame_number));
-      }
+      const double now_s = clock_.now_s();
+      const bool timed_out =
+          m.stepped ? now_s - m.step_wait_since_s >= m.step_timeout_s : now_s - m.last_progress_s > m.stall_timeout_s;
+      if (end_of_file || timed_out) end_stream(m.stats.last_frame_index < static_cast<int>(m.last_frame_number));
     }
     return HalStatus::no_data;
   }
   if (waited != openni::STATUS_OK) return HalStatus::io_error;
   if (m.stream.readFrame(&m.frame) != openni::STATUS_OK || !m.frame.isValid()) return HalStatus::io_error;
   ++m.stats.received;
-  m.last_progress = std::chrono::steady_clock::now();
+  m.last_progress_s = clock_.now_s();
+  m.step_waiting = false;
 
   const int index = m.frame.getFrameIndex();
   const std::uint64_t ts_us = m.frame.getTimestamp();
@@ -434,8 +457,9 @@ HalStatus Openni2Camera::on_read(hal::DepthFrame& out) noexcept {
   const bool copied =
       m.frame.getWidth() == m.width && m.frame.getHeight() == m.height && mode.getPixelFormat() == m.format &&
       m.frame.getStrideInBytes() > 0 && m.frame.getDataSize() > 0 &&
-      copy_depth_image(static_cast<const std::uint8_t*>(m.frame.getData()), static_cast<std::size_t>(m.frame.getDataSize()),
-                       m.width, m.height, static_cast<std::size_t>(m.frame.getStrideInBytes()), m.image.data(), m.image.size());
+      copy_depth_image(static_cast<const std::uint8_t*>(m.frame.getData()),
+                       static_cast<std::size_t>(m.frame.getDataSize()), m.width, m.height,
+                       static_cast<std::size_t>(m.frame.getStrideInBytes()), m.image.data(), m.image.size());
   m.frame.release();
   // The last frame of a recording: stop the stream now (the player would spin on the file end).
   const bool last = m.recording && index >= 0 && static_cast<std::uint32_t>(index) >= m.last_frame_number;

@@ -197,7 +197,8 @@ CalibrationError make_scaling(const Calibration& c, Scaling& out) noexcept {
   return CalibrationError::none;
 }
 
-void gauges_to_wrench(const Scaling& scaling, const std::int16_t gauges[6], const double bias[6], double wrench[6]) noexcept {
+void gauges_to_wrench(const Scaling& scaling, const std::int16_t gauges[6], const double bias[6],
+                      double wrench[6]) noexcept {
   double g[6];
   for (int k = 0; k < 6; ++k) g[k] = static_cast<double>(gauges[k]) - bias[k];
   for (int r = 0; r < 6; ++r) {

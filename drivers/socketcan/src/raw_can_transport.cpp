@@ -48,7 +48,8 @@ hal::HalStatus RawCanTransport::open() noexcept {
     filters[i].can_id = filter_ids()[i];
     filters[i].can_mask = CAN_EFF_FLAG | CAN_RTR_FLAG | CAN_SFF_MASK;
   }
-  if (n > 0 && ::setsockopt(fd, SOL_CAN_RAW, CAN_RAW_FILTER, filters, static_cast<socklen_t>(n * sizeof(can_filter))) < 0) {
+  if (n > 0 &&
+      ::setsockopt(fd, SOL_CAN_RAW, CAN_RAW_FILTER, filters, static_cast<socklen_t>(n * sizeof(can_filter))) < 0) {
     return fail(hal::HalStatus::io_error);
   }
   const can_err_mask_t err_mask = config_.error_mask & CAN_ERR_MASK;

@@ -188,7 +188,8 @@ hal::HalStatus SeqpacketCanListener::accept(SeqpacketCanTransport& out) noexcept
   const int fd = ::accept4(fd_, nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC);
   if (fd < 0) {
     last_errno_ = errno;
-    return errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR ? hal::HalStatus::no_data : hal::HalStatus::io_error;
+    return errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR ? hal::HalStatus::no_data
+                                                                     : hal::HalStatus::io_error;
   }
   return out.adopt(fd);
 }

@@ -12,9 +12,9 @@
 namespace pliant::drivers::socketcan::detail {
 
 struct Record {
-  ssize_t bytes = -1;          ///< record length, 0 at end of stream, -1 on error (err set)
-  int err = 0;                 ///< errno when bytes < 0
-  bool truncated = false;      ///< the record was longer than the buffer
+  ssize_t bytes = -1;             ///< record length, 0 at end of stream, -1 on error (err set)
+  int err = 0;                    ///< errno when bytes < 0
+  bool truncated = false;         ///< the record was longer than the buffer
   std::int64_t realtime_ns = -1;  ///< SO_TIMESTAMP, -1 if none
 };
 

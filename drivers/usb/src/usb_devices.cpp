@@ -30,7 +30,8 @@ void append(std::string& text, const std::string& part) {
 
 }  // namespace
 
-std::vector<UsbDeviceRow> describe_usb_devices(const std::vector<UsbDeviceInfo>& devices, const UsbRowOptions& options) {
+std::vector<UsbDeviceRow> describe_usb_devices(const std::vector<UsbDeviceInfo>& devices,
+                                               const UsbRowOptions& options) {
   std::vector<UsbDeviceRow> rows;
   for (const UsbDeviceInfo& device : devices) {
     const UsbIdEntry* entry = lookup_usb_id(device.vendor_id, device.product_id);

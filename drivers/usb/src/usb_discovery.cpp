@@ -29,7 +29,8 @@ bool describe(libusb_device* device, UsbDeviceInfo& out) {
 
 std::string no_bus_note() {
   struct stat st {};
-  if (::stat("/dev/bus/usb", &st) != 0) return "libusb sees no USB device; /dev/bus/usb does not exist (a container without USB?)";
+  if (::stat("/dev/bus/usb", &st) != 0)
+    return "libusb sees no USB device; /dev/bus/usb does not exist (a container without USB?)";
   return "libusb sees no USB device";
 }
 

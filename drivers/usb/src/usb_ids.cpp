@@ -7,7 +7,8 @@ constexpr UsbDeviceKind kDepth = UsbDeviceKind::depth_camera;
 constexpr UsbDeviceKind kPart = UsbDeviceKind::camera_part;
 constexpr UsbDeviceKind kCan = UsbDeviceKind::can_adapter;
 
-constexpr const char* kFreenectNote = "OpenNI2 needs libfreenect's OpenNI2 driver (libFreenectDriver), which Debian does not ship";
+constexpr const char* kFreenectNote =
+    "OpenNI2 needs libfreenect's OpenNI2 driver (libFreenectDriver), which Debian does not ship";
 constexpr const char* kOrbbecNote = "OpenNI2 needs Orbbec's OpenNI2 driver (liborbbec), which Debian does not ship";
 constexpr const char* kPs1080Note = "Debian's libPS1080 OpenNI2 driver";
 constexpr const char* kPsLinkNote = "Debian's libPSLink OpenNI2 driver";
@@ -26,8 +27,10 @@ constexpr UsbIdEntry kTable[] = {
     {0x045e, 0x02bf, 0x02bf, kDepth, "Microsoft Kinect for Windows v1 camera", "openni2", kFreenectNote},
     {0x045e, 0x02be, 0x02be, kPart, "Microsoft Kinect for Windows v1 audio", "none", "microphone array"},
     {0x045e, 0x02c3, 0x02c3, kPart, "Microsoft Kinect for Windows v1 audio (SDK firmware)", "none", "microphone array"},
-    {0x045e, 0x02bb, 0x02bb, kPart, "Microsoft Kinect for Windows v1 audio (beta firmware)", "none", "microphone array"},
-    {0x045e, 0x02d9, 0x02d9, kDepth, "Microsoft Kinect v2", "none", "needs libfreenect2; OpenNI2 has no Kinect v2 driver"},
+    {0x045e, 0x02bb, 0x02bb, kPart, "Microsoft Kinect for Windows v1 audio (beta firmware)", "none",
+     "microphone array"},
+    {0x045e, 0x02d9, 0x02d9, kDepth, "Microsoft Kinect v2", "none",
+     "needs libfreenect2; OpenNI2 has no Kinect v2 driver"},
     // PrimeSense PS1080 family (OpenNI2 Source/Drivers/PS1080/Sensor/XnDeviceEnumeration.cpp).
     {0x1d27, 0x0500, 0x0500, kDepth, "PrimeSense PS1080 sensor", "openni2", kPs1080Note},
     {0x1d27, 0x0600, 0x0600, kDepth, "ASUS Xtion PRO (PS1080)", "openni2", kPs1080Note},
@@ -62,7 +65,8 @@ constexpr UsbIdEntry kTable[] = {
     {0x0c72, 0x0013, 0x0013, kCan, "PEAK PCAN-Chip USB", "socketcan", kPeakNote},
     {0x0c72, 0x0014, 0x0014, kCan, "PEAK PCAN-USB X6", "socketcan", kPeakNote},
     // gs_usb devices (Linux drivers/net/can/usb/gs_usb.c).
-    {0x1d50, 0x606f, 0x606f, kCan, "Geschwister Schneider USB/CAN (candleLight, CANable gs_usb firmware)", "socketcan", kGsUsbNote},
+    {0x1d50, 0x606f, 0x606f, kCan, "Geschwister Schneider USB/CAN (candleLight, CANable gs_usb firmware)", "socketcan",
+     kGsUsbNote},
     {0x1209, 0x2323, 0x2323, kCan, "candleLight USB-CAN", "socketcan", kGsUsbNote},
     {0x1cd2, 0x606f, 0x606f, kCan, "CES CANext FD", "socketcan", kGsUsbNewNote},
     {0x16d0, 0x10b8, 0x10b8, kCan, "ABE CANdebugger FD", "socketcan", kGsUsbNewNote},
@@ -77,7 +81,8 @@ constexpr UsbIdEntry kTable[] = {
     {0x2bc5, 0x0501, 0x0520, kPart, "Orbbec UVC colour camera", "opencv",
      "the colour side of an Astra Pro-type camera: a UVC webcam (/dev/videoN)"},
     // Whole vendors.
-    {0x1d27, 0x0000, 0xffff, kDepth, "PrimeSense device (unknown model)", "openni2", "may be served by libPS1080 or libPSLink"},
+    {0x1d27, 0x0000, 0xffff, kDepth, "PrimeSense device (unknown model)", "openni2",
+     "may be served by libPS1080 or libPSLink"},
     {0x2bc5, 0x0000, 0xffff, kDepth, "Orbbec device (unknown model)", "openni2", kOrbbecNote},
     {0x0bfd, 0x0000, 0xffff, kCan, "Kvaser CAN interface (unknown model)", "socketcan", kKvaserNote},
 };
@@ -100,7 +105,8 @@ const UsbIdEntry* usb_id_table(std::size_t& count) noexcept {
 
 const UsbIdEntry* lookup_usb_id(std::uint16_t vendor_id, std::uint16_t product_id) noexcept {
   for (const UsbIdEntry& entry : kTable) {
-    if (entry.vendor_id == vendor_id && product_id >= entry.product_first && product_id <= entry.product_last) return &entry;
+    if (entry.vendor_id == vendor_id && product_id >= entry.product_first && product_id <= entry.product_last)
+      return &entry;
   }
   return nullptr;
 }

@@ -46,7 +46,8 @@ void UsbPresence::arrive(const UsbDeviceInfo& device, std::vector<UsbEvent>& eve
 }
 
 void UsbPresence::leave(const UsbDeviceKey& key, std::vector<UsbEvent>& events) {
-  const auto at = std::find_if(present_.begin(), present_.end(), [&](const UsbDeviceInfo& known) { return known.key == key; });
+  const auto at =
+      std::find_if(present_.begin(), present_.end(), [&](const UsbDeviceInfo& known) { return known.key == key; });
   if (at == present_.end()) {
     ++counters_.duplicates;
     return;
@@ -72,8 +73,8 @@ void UsbPresence::reconcile(const std::vector<UsbDeviceInfo>& now, std::vector<U
     present_.erase(present_.begin() + static_cast<std::ptrdiff_t>(i));
   }
   for (const UsbDeviceInfo& device : now) {
-    const bool known = std::any_of(present_.begin(), present_.end(),
-                                   [&](const UsbDeviceInfo& p) { return p.key == device.key; });
+    const bool known =
+        std::any_of(present_.begin(), present_.end(), [&](const UsbDeviceInfo& p) { return p.key == device.key; });
     if (known) continue;  // present already, or listed twice in `now`
     present_.push_back(device);
     events.push_back({UsbEventKind::arrived, device});

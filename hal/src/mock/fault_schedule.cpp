@@ -7,8 +7,8 @@
 namespace pliant::hal {
 namespace {
 
-constexpr const char* kNames[kFaultKindCount] = {"drop",     "freeze_data", "freeze_stamp", "nan",   "stamp_jump",
-                                                 "fault_bits", "occlude",   "disconnect",   "bus_off", "timeout"};
+constexpr const char* kNames[kFaultKindCount] = {"drop",       "freeze_data", "freeze_stamp", "nan",     "stamp_jump",
+                                                 "fault_bits", "occlude",     "disconnect",   "bus_off", "timeout"};
 
 bool valid_value(FaultKind kind, double value) noexcept {
   if (std::isnan(value)) return true;

@@ -77,7 +77,8 @@ int FaultScript::events() const noexcept {
   return total;
 }
 
-HalStatus parse_fault_script(const char* text, std::size_t length, FaultScript& script, FaultScriptError& error) noexcept {
+HalStatus parse_fault_script(const char* text, std::size_t length, FaultScript& script,
+                             FaultScriptError& error) noexcept {
   for (FaultSchedule& s : script.schedules) s.clear();
   error = FaultScriptError{};
   if (text == nullptr && length > 0) return fail(error, 1, 0, "no text", HalStatus::invalid_argument);
@@ -101,35 +102,46 @@ HalStatus parse_fault_script(const char* text, std::size_t length, FaultScript& 
       }
       const std::size_t begin = i;
       while (i < line_length && start[i] != ' ' && start[i] != '\t' && start[i] != '#') ++i;
-      if (count == kMaxFields) return fail(error, line, begin, "too many fields (t_s kind device duration_s [value])", HalStatus::invalid_argument);
+      if (count == kMaxFields)
+        return fail(error, line, begin, "too many fields (t_s kind device duration_s [value])",
+                    HalStatus::invalid_argument);
       fields[count].begin = start + begin;
       fields[count].length = i - begin;
       fields[count].column = begin;
       ++count;
     }
     if (count == 0) continue;
-    if (count < 4) return fail(error, line, count > 0 ? fields[count - 1].column : 0, "too few fields (t_s kind device duration_s [value])",
-                               HalStatus::invalid_argument);
+    if (count < 4)
+      return fail(error, line, count > 0 ? fields[count - 1].column : 0,
+                  "too few fields (t_s kind device duration_s [value])", HalStatus::invalid_argument);
     FaultEvent event;
-    if (!parse_number(fields[0], event.start_s)) return fail(error, line, fields[0].column, "start time is not a finite number", HalStatus::invalid_argument);
+    if (!parse_number(fields[0], event.start_s))
+      return fail(error, line, fields[0].column, "start time is not a finite number", HalStatus::invalid_argument);
     if (!parse_fault_kind(fields[1].begin, fields[1].length, event.kind)) {
       return fail(error, line, fields[1].column, "unknown fault kind", HalStatus::invalid_argument);
     }
     FaultDevice device = FaultDevice::gripper;
-    if (!parse_device(fields[2], device)) return fail(error, line, fields[2].column, "unknown device (gripper, ft, observer, color, depth)", HalStatus::invalid_argument);
+    if (!parse_device(fields[2], device))
+      return fail(error, line, fields[2].column, "unknown device (gripper, ft, observer, color, depth)",
+                  HalStatus::invalid_argument);
     if ((fault_bit(event.kind) & fault_device_kinds(device)) == 0) {
-      return fail(error, line, fields[1].column, "fault kind not supported by this device", HalStatus::invalid_argument);
+      return fail(error, line, fields[1].column, "fault kind not supported by this device",
+                  HalStatus::invalid_argument);
     }
     if (!parse_number(fields[3], event.duration_s) || !(event.duration_s > 0)) {
       return fail(error, line, fields[3].column, "duration is not a finite number > 0", HalStatus::invalid_argument);
     }
     if (count == 5) {
-      const bool parsed = event.kind == FaultKind::fault_bits ? parse_bits(fields[4], event.value) : parse_number(fields[4], event.value);
-      if (!parsed) return fail(error, line, fields[4].column, "value is not a valid number for this kind", HalStatus::invalid_argument);
+      const bool parsed = event.kind == FaultKind::fault_bits ? parse_bits(fields[4], event.value)
+                                                              : parse_number(fields[4], event.value);
+      if (!parsed)
+        return fail(error, line, fields[4].column, "value is not a valid number for this kind",
+                    HalStatus::invalid_argument);
     }
     const HalStatus added = script.schedules[static_cast<int>(device)].add(event);
     if (added == HalStatus::capacity_exceeded) return fail(error, line, 0, "too many events for one device", added);
-    if (added != HalStatus::ok) return fail(error, line, count == 5 ? fields[4].column : 0, "value out of range for this kind", added);
+    if (added != HalStatus::ok)
+      return fail(error, line, count == 5 ? fields[4].column : 0, "value out of range for this kind", added);
   }
   return HalStatus::ok;
 }

@@ -42,8 +42,8 @@ HalStatus FaultyCamera<Camera, Frame, Element, Supported>::on_read(Frame& out) n
     count(injected_, FaultKind::drop);
     return HalStatus::no_data;  // its sequence number becomes a gap
   }
-  const std::size_t bytes =
-      static_cast<std::size_t>(frame.height > 0 ? frame.height : 0) * static_cast<std::size_t>(frame.stride_bytes > 0 ? frame.stride_bytes : 0);
+  const std::size_t bytes = static_cast<std::size_t>(frame.height > 0 ? frame.height : 0) *
+                            static_cast<std::size_t>(frame.stride_bytes > 0 ? frame.stride_bytes : 0);
   const std::size_t elements = bytes / sizeof(Element);
   const bool fits = frame.data != nullptr && elements <= delivered_.size();
   const bool pixel_fault = f.has(FaultKind::freeze_data) || f.has(FaultKind::freeze_stamp) || f.has(FaultKind::nan);
@@ -77,7 +77,8 @@ HalStatus FaultyCamera<Camera, Frame, Element, Supported>::on_read(Frame& out) n
     result.header.status_bits |= std::isnan(v) ? kFrameDeviceFault : static_cast<std::uint32_t>(v);
   }
   // Keep what was delivered for the freeze kinds (only when the schedule has them).
-  const bool freezes = (schedule_.kinds() & (fault_bit(FaultKind::freeze_data) | fault_bit(FaultKind::freeze_stamp))) != 0;
+  const bool freezes =
+      (schedule_.kinds() & (fault_bit(FaultKind::freeze_data) | fault_bit(FaultKind::freeze_stamp))) != 0;
   if (freezes) {
     if (!fits) {
       has_last_ = false;
@@ -93,7 +94,6 @@ HalStatus FaultyCamera<Camera, Frame, Element, Supported>::on_read(Frame& out) n
   out = result;
   return HalStatus::ok;
 }
-
 
 template class FaultyCamera<ColorCamera, ColorFrame, std::uint8_t, kColorCameraFaults>;
 template class FaultyCamera<DepthCamera, DepthFrame, std::uint16_t, kDepthCameraFaults>;

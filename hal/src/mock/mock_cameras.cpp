@@ -113,9 +113,9 @@ HalStatus MockColorCamera::on_read(ColorFrame& out) noexcept {
 
 HalStatus MockDepthCamera::on_configure() {
   const MockDepthCameraConfig& c = config_;
-  if (!valid_size(c.width, c.height) || !(c.plane_depth_m > 0 && c.plane_depth_m <= 65) || !std::isfinite(c.tilt_m_per_px) ||
-      !std::isfinite(c.bump_height_m) || !(std::isfinite(c.noise_mm) && c.noise_mm >= 0) ||
-      !(c.fov_x_deg > 0 && c.fov_x_deg < 180)) {
+  if (!valid_size(c.width, c.height) || !(c.plane_depth_m > 0 && c.plane_depth_m <= 65) ||
+      !std::isfinite(c.tilt_m_per_px) || !std::isfinite(c.bump_height_m) ||
+      !(std::isfinite(c.noise_mm) && c.noise_mm >= 0) || !(c.fov_x_deg > 0 && c.fov_x_deg < 180)) {
     return HalStatus::invalid_argument;
   }
   const HalStatus s = stream_.configure(c.period_s, c.latency_s, kDepthCameraFaults);
@@ -154,7 +154,8 @@ HalStatus MockDepthCamera::on_read(DepthFrame& out) noexcept {
     for (int y = 0; y < c.height; ++y) {
       for (int x = 0; x < c.width; ++x) {
         const double r2 = (x - centre_x) * (x - centre_x) + (y - centre_y) * (y - centre_y);
-        const double depth_m = c.plane_depth_m + c.tilt_m_per_px * x - c.bump_height_m * std::exp(-r2 / (2 * sigma * sigma));
+        const double depth_m =
+            c.plane_depth_m + c.tilt_m_per_px * x - c.bump_height_m * std::exp(-r2 / (2 * sigma * sigma));
         const double mm = std::clamp(std::round(depth_m * 1000 + noise(rng_)), 1.0, 65535.0);
         image_[static_cast<std::size_t>(y) * static_cast<std::size_t>(c.width) + static_cast<std::size_t>(x)] =
             static_cast<std::uint16_t>(mm);

@@ -11,7 +11,8 @@ namespace pliant::hal {
 HalStatus MockForceTorqueSensor::on_configure() {
   const MockForceTorqueConfig& c = config_;
   if (!plant_.configured()) return HalStatus::invalid_argument;
-  if (!(std::isfinite(c.force_noise_n) && c.force_noise_n >= 0) || !(std::isfinite(c.torque_noise_nm) && c.torque_noise_nm >= 0)) {
+  if (!(std::isfinite(c.force_noise_n) && c.force_noise_n >= 0) ||
+      !(std::isfinite(c.torque_noise_nm) && c.torque_noise_nm >= 0)) {
     return HalStatus::invalid_argument;
   }
   const Eigen::Matrix3d r = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(c.rotation);
@@ -59,7 +60,8 @@ HalStatus MockForceTorqueSensor::on_read(WrenchReading& out) noexcept {
       const Eigen::Matrix3d rot = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(config_.rotation);
       const Eigen::Vector3d contact(plant_.grip_force_n(), 0, 0);
       const Eigen::Vector3d force = rot.transpose() * (contact + Eigen::Map<const Eigen::Vector3d>(config_.load_n));
-      const Eigen::Vector3d torque = rot.transpose() * Eigen::Map<const Eigen::Vector3d>(config_.lever_m).cross(contact);
+      const Eigen::Vector3d torque =
+          rot.transpose() * Eigen::Map<const Eigen::Vector3d>(config_.lever_m).cross(contact);
       for (int d = 0; d < 3; ++d) {
         r.wrench[d] = force(d) + config_.force_noise_n * normal_(rng_);
         r.wrench[3 + d] = torque(d) + config_.torque_noise_nm * normal_(rng_);

@@ -79,7 +79,8 @@ HalStatus MockGripper::on_read(GripperReading& out) noexcept {
       const double force = plant_.grip_force_n();
       r.width_m = plant_.width_m() + config_.width_noise_m * normal_(rng_);
       r.force_n = force + config_.force_noise_n * normal_(rng_);
-      r.current_a = config_.current_offset_a + force / config_.current_gain_n_per_a + config_.current_noise_a * normal_(rng_);
+      r.current_a =
+          config_.current_offset_a + force / config_.current_gain_n_per_a + config_.current_noise_a * normal_(rng_);
       r.target_width_m = plant_.target_width_m();
       std::uint32_t bits = kGripperActivated;
       if (plant_.moving()) bits |= kGripperMoving;
@@ -100,8 +101,8 @@ HalStatus MockGripper::on_read(GripperReading& out) noexcept {
     if (f.has(FaultKind::fault_bits)) {
       stream_.count(FaultKind::fault_bits);
       const double v = f.value[static_cast<int>(FaultKind::fault_bits)];
-      r.header.status_bits |= std::isnan(v) ? (std::uint32_t{config_.fault_code} << kGripperFaultCodeShift)
-                                            : static_cast<std::uint32_t>(v);
+      r.header.status_bits |=
+          std::isnan(v) ? (std::uint32_t{config_.fault_code} << kGripperFaultCodeShift) : static_cast<std::uint32_t>(v);
     }
   }
   r.header.sequence = sequence;

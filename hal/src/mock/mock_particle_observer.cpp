@@ -26,7 +26,8 @@ HalStatus MockParticleObserver::on_configure() {
   occlusion_order_.resize(static_cast<std::size_t>(n_));
   for (int i = 0; i < n_; ++i) occlusion_order_[static_cast<std::size_t>(i)] = i;
   const SimulatedGrasp::Vec* rest = plant_.rest_positions();
-  std::stable_sort(occlusion_order_.begin(), occlusion_order_.end(), [rest](int a, int b) { return rest[a](1) > rest[b](1); });
+  std::stable_sort(occlusion_order_.begin(), occlusion_order_.end(),
+                   [rest](int a, int b) { return rest[a](1) > rest[b](1); });
   rng_.seed(c.seed);
   next_capture_ = 0;
   has_last_ = false;

@@ -132,7 +132,8 @@ HalStatus ReplayParticleObserver::on_read(ParticleFrame& out) noexcept {
   int observed = 0;
   for (int i = 0; i < n; ++i) {
     bool finite = true;
-    for (int d = 0; d < dimension_; ++d) finite = finite && std::isfinite(frame_[static_cast<std::size_t>(i * dimension_ + d)]);
+    for (int d = 0; d < dimension_; ++d)
+      finite = finite && std::isfinite(frame_[static_cast<std::size_t>(i * dimension_ + d)]);
     observed += finite ? 1 : 0;
   }
   set_header(out.header, s, bits);

@@ -51,11 +51,13 @@ std::vector<double> lattice(const SimulatedObjectConfig& o) {
 }
 
 bool valid_object(const SimulatedObjectConfig& o) {
-  const bool dims = o.shape == ObjectShape::box ? (o.nx >= 2 && o.ny >= 2 && o.nz >= 2 && o.nx <= 64 && o.ny <= 64 && o.nz <= 64)
+  const bool dims = o.shape == ObjectShape::box
+                        ? (o.nx >= 2 && o.ny >= 2 && o.nz >= 2 && o.nx <= 64 && o.ny <= 64 && o.nz <= 64)
                     : o.shape == ObjectShape::cylinder ? (o.nx >= 1 && o.nx <= 32 && o.nz >= 2 && o.nz <= 64)
-                                                        : (o.nx >= 1 && o.nx <= 32);
+                                                       : (o.nx >= 1 && o.nx <= 32);
   return dims && std::isfinite(o.spacing_m) && o.spacing_m > 0 && o.msm_beta >= 0 && o.msm_beta <= 1 &&
-         std::isfinite(o.stiffness_n_per_m) && o.stiffness_n_per_m > 0 && std::isfinite(o.stiffening) && o.stiffening >= 0;
+         std::isfinite(o.stiffness_n_per_m) && o.stiffness_n_per_m > 0 && std::isfinite(o.stiffening) &&
+         o.stiffening >= 0;
 }
 
 }  // namespace
@@ -286,7 +288,8 @@ void SimulatedGrasp::relax() noexcept {
     if (msm_step(model_, params_, input, state_) != Status::ok) ++counters_.step_errors;
     ++steps;
     double move = 0;
-    for (int i = 0; i < n; ++i) move = std::max(move, (state_.position[i] - previous_[static_cast<std::size_t>(i)]).norm());
+    for (int i = 0; i < n; ++i)
+      move = std::max(move, (state_.position[i] - previous_[static_cast<std::size_t>(i)]).norm());
     quiet = move <= tolerance_m_ ? quiet + 1 : 0;
   }
   counters_.msm_steps += static_cast<std::uint64_t>(steps);

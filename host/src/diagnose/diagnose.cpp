@@ -49,11 +49,13 @@ class Scorer {
     for (int k = 0; k < recording_.frame_count(); ++k) {
       const bool held = held_out_[static_cast<std::size_t>(k)] != 0;
       for (int i = 0; i < n; ++i) {
-        const std::size_t pair = static_cast<std::size_t>(k) * static_cast<std::size_t>(n) + static_cast<std::size_t>(i);
+        const std::size_t pair =
+            static_cast<std::size_t>(k) * static_cast<std::size_t>(n) + static_cast<std::size_t>(i);
         if (pairs_[pair] == 0) continue;
         double squared = 0;
         for (int d = 0; d < dim; ++d) {
-          const double r = simulated[pair * static_cast<std::size_t>(dim) + static_cast<std::size_t>(d)] - recording_.position(k, i, d);
+          const double r = simulated[pair * static_cast<std::size_t>(dim) + static_cast<std::size_t>(d)] -
+                           recording_.position(k, i, d);
           squared += r * r;
         }
         if (!std::isfinite(squared)) continue;
@@ -77,10 +79,12 @@ class Scorer {
     for (int k = 0; k < recording_.frame_count(); ++k) {
       if (held_out_[static_cast<std::size_t>(k)] != 0) continue;
       for (int i = 0; i < n; ++i) {
-        const std::size_t pair = static_cast<std::size_t>(k) * static_cast<std::size_t>(n) + static_cast<std::size_t>(i);
+        const std::size_t pair =
+            static_cast<std::size_t>(k) * static_cast<std::size_t>(n) + static_cast<std::size_t>(i);
         if (pairs_[pair] == 0) continue;
         for (int d = 0; d < dim; ++d) {
-          const double r = simulated[pair * static_cast<std::size_t>(dim) + static_cast<std::size_t>(d)] - recording_.position(k, i, d);
+          const double r = simulated[pair * static_cast<std::size_t>(dim) + static_cast<std::size_t>(d)] -
+                           recording_.position(k, i, d);
           values.push_back(std::isfinite(r) ? r : 0.0);
         }
       }
@@ -224,8 +228,10 @@ class Fitter {
     for (std::size_t p = 0; p < effect->parameters.size(); ++p) {
       const EffectParameter& parameter = effect->parameters[p];
       double u = 0.0;
-      if (std::isfinite(parameter.null_value)) u = parameter.coordinate(parameter.null_value);
-      else if (effect->replaces_beta) u = parameter.coordinate(start_beta);
+      if (std::isfinite(parameter.null_value))
+        u = parameter.coordinate(parameter.null_value);
+      else if (effect->replaces_beta)
+        u = parameter.coordinate(start_beta);
       start.push_back(u);
       if (parameter.scanned) scanned.push_back(static_cast<int>(p) + 1);
     }
@@ -319,7 +325,8 @@ class Fitter {
       for (int a = 0; a < m; ++a) {
         g(a) = gradient(free[static_cast<std::size_t>(a)]);
         for (int b = 0; b < m; ++b) {
-          normal(a, b) = jacobian.col(free[static_cast<std::size_t>(a)]).dot(jacobian.col(free[static_cast<std::size_t>(b)]));
+          normal(a, b) =
+              jacobian.col(free[static_cast<std::size_t>(a)]).dot(jacobian.col(free[static_cast<std::size_t>(b)]));
         }
       }
       bool accepted = false;
@@ -374,7 +381,8 @@ class Fitter {
       down[static_cast<std::size_t>(c)] = std::max(0.0, u[static_cast<std::size_t>(c)] - h);
       const std::vector<double> vu = physical(effect, up);
       const std::vector<double> vd = physical(effect, down);
-      const double step = c == 0 ? up[0] - down[0] : vu[static_cast<std::size_t>(c - 1)] - vd[static_cast<std::size_t>(c - 1)];
+      const double step =
+          c == 0 ? up[0] - down[0] : vu[static_cast<std::size_t>(c - 1)] - vd[static_cast<std::size_t>(c - 1)];
       evaluations += 2;
       const Eigen::VectorXd ru = scorer_.fit_residuals(simulator_.simulate(settings(effect, up[0], vu)));
       const Eigen::VectorXd rd = scorer_.fit_residuals(simulator_.simulate(settings(effect, down[0], vd)));
@@ -453,7 +461,8 @@ std::string describe_region(const std::vector<std::vector<int>>& patches, const 
 }
 
 std::vector<double> magnitudes(const Recording& recording, const std::vector<double>& simulated) {
-  return residual_magnitudes(make_residual_field(recording.positions, simulated, recording.particle_count, recording.dimension));
+  return residual_magnitudes(
+      make_residual_field(recording.positions, simulated, recording.particle_count, recording.dimension));
 }
 
 }  // namespace
@@ -559,8 +568,8 @@ DiagnoseResult diagnose_recording(const Recording& recording, const DiagnoseOpti
   const ResidualField field = make_residual_field(recording.positions, baseline.simulated, n, dim);
   out.location = locate_mismatch(field, recording.frame_times_s, noise_std);
   context.located = out.location.particles;
-  context.patches = spatial_patches(simulator.rest(), dim, std::max(6, (n - static_cast<int>(recording.fixed.size())) / 8),
-                                    recording.fixed);
+  context.patches = spatial_patches(simulator.rest(), dim,
+                                    std::max(6, (n - static_cast<int>(recording.fixed.size())) / 8), recording.fixed);
   const std::map<std::string, double> signatures =
       residual_signatures(recording, baseline.simulated, field, out.location, noise_std);
 
@@ -637,9 +646,9 @@ DiagnoseResult diagnose_recording(const Recording& recording, const DiagnoseOpti
     out.augmented.rms = f.score.held_rms();
     out.improvement = 1.0 - out.augmented.rms / out.baseline.rms;
     std::ostringstream text;
-    text << "The elastic model misses " << (where.str().empty() ? std::string("the motion") : where.str())
-         << " by " << number(out.baseline.rms) << " " << recording.length_unit << " rms (noise " << number(noise_rms)
-         << "); " << effect.physics << " explains it, cutting the held-out rms by " << number(100.0 * out.improvement)
+    text << "The elastic model misses " << (where.str().empty() ? std::string("the motion") : where.str()) << " by "
+         << number(out.baseline.rms) << " " << recording.length_unit << " rms (noise " << number(noise_rms) << "); "
+         << effect.physics << " explains it, cutting the held-out rms by " << number(100.0 * out.improvement)
          << " % and moving msm_beta from " << number(baseline.beta) << " to " << number(f.beta) << ".";
     if (effect.replaces_beta) text << " " << describe_region(context.patches, split_patches(context.patches, f.values));
     if (ranked.size() > 1 && ranked[1].passes && fits[ranked[1].index].bic - f.bic < 6.0) {
@@ -702,18 +711,19 @@ nlohmann::json diagnosis_json(const Diagnosis& d) {
     if (std::isfinite(c.force_rms)) j["force_rms"] = c.force_rms;
     candidates.push_back(j);
   }
-  nlohmann::json document = {{"format", "pliant-diagnosis"},
-          {"version", 1},
-          {"recording", d.recording},
-          {"baseline", model(d.baseline)},
-          {"noise_rms", d.noise_rms},
-          {"verdict", d.verdict},
-          {"effect", d.effect},
-          {"explanation", d.explanation},
-          {"location", {{"particles", d.location.particles}, {"t_start", d.location.t_start}, {"t_end", d.location.t_end}}},
-          {"augmented", model(d.augmented)},
-          {"improvement", d.improvement},
-          {"candidates", candidates}};
+  nlohmann::json document = {
+      {"format", "pliant-diagnosis"},
+      {"version", 1},
+      {"recording", d.recording},
+      {"baseline", model(d.baseline)},
+      {"noise_rms", d.noise_rms},
+      {"verdict", d.verdict},
+      {"effect", d.effect},
+      {"explanation", d.explanation},
+      {"location", {{"particles", d.location.particles}, {"t_start", d.location.t_start}, {"t_end", d.location.t_end}}},
+      {"augmented", model(d.augmented)},
+      {"improvement", d.improvement},
+      {"candidates", candidates}};
   if (!std::isfinite(d.noise_rms)) document["noise_rms"] = nullptr;
   if (std::isfinite(d.force_noise_rms)) document["force_noise_rms"] = d.force_noise_rms;
   return document;
@@ -727,11 +737,12 @@ std::string diagnosis_summary(const Diagnosis& d, const std::string& length_unit
     const auto youngs = d.baseline.parameters.find("youngs_modulus");
     out << "\n  baseline fem, E " << number(youngs != d.baseline.parameters.end() ? youngs->second : 0.0) << " Pa";
     if (std::isfinite(d.baseline.force_rms)) {
-      out << ", held-out force rms " << number(d.baseline.force_rms) << " N (noise " << number(d.force_noise_rms) << " N)";
+      out << ", held-out force rms " << number(d.baseline.force_rms) << " N (noise " << number(d.force_noise_rms)
+          << " N)";
     }
     if (std::isfinite(d.baseline.rms)) {
-      out << ", held-out rms " << number(d.baseline.rms) << " " << length_unit << " (noise " << number(d.noise_rms) << " "
-          << length_unit << ")";
+      out << ", held-out rms " << number(d.baseline.rms) << " " << length_unit << " (noise " << number(d.noise_rms)
+          << " " << length_unit << ")";
     }
     out << "\n";
     if (d.verdict == "missing_physics" && d.effect != "unknown") {
@@ -739,14 +750,16 @@ std::string diagnosis_summary(const Diagnosis& d, const std::string& length_unit
       const auto augmented_youngs = d.augmented.parameters.find("youngs_modulus");
       if (augmented_youngs != d.augmented.parameters.end()) out << " E " << number(augmented_youngs->second) << " Pa,";
       if (std::isfinite(d.augmented.force_rms)) out << " held-out force rms " << number(d.augmented.force_rms) << " N,";
-      if (std::isfinite(d.augmented.rms)) out << " held-out rms " << number(d.augmented.rms) << " " << length_unit << ",";
+      if (std::isfinite(d.augmented.rms))
+        out << " held-out rms " << number(d.augmented.rms) << " " << length_unit << ",";
       out << " improvement " << number(100.0 * d.improvement) << " %\n";
     }
     out << "  " << d.explanation << "\n";
     return out.str();
   }
   out << "\n  baseline msm_beta " << number(d.baseline.parameters.at("msm_beta")) << ", held-out rms "
-      << number(d.baseline.rms) << " " << length_unit << ", noise " << number(d.noise_rms) << " " << length_unit << "\n";
+      << number(d.baseline.rms) << " " << length_unit << ", noise " << number(d.noise_rms) << " " << length_unit
+      << "\n";
   if (d.verdict == "missing_physics" && d.effect != "unknown") {
     out << "  with " << d.effect << ": held-out rms " << number(d.augmented.rms) << " " << length_unit
         << " (improvement " << number(100.0 * d.improvement) << " %)\n";

@@ -61,9 +61,7 @@ double EffectParameter::coordinate(double physical) const {
     case Scale::logarithmic:
       u = physical > 0 && upper > lower ? std::log(physical / lower) / std::log(upper / lower) : 0.0;
       break;
-    case Scale::linear:
-      u = upper > lower ? (physical - lower) / (upper - lower) : 0.0;
-      break;
+    case Scale::linear: u = upper > lower ? (physical - lower) / (upper - lower) : 0.0; break;
   }
   return std::isfinite(u) ? std::clamp(u, 0.0, 1.0) : 0.0;
 }
@@ -97,7 +95,8 @@ std::vector<std::vector<int>> spatial_patches(const std::vector<double>& all_res
     centres.push_back(position(next));
     int farthest = 0;
     for (int i = 0; i < n; ++i) {
-      nearest[static_cast<std::size_t>(i)] = std::min(nearest[static_cast<std::size_t>(i)], squared_distance(rest, dimension, i, centres.back()));
+      nearest[static_cast<std::size_t>(i)] =
+          std::min(nearest[static_cast<std::size_t>(i)], squared_distance(rest, dimension, i, centres.back()));
       if (nearest[static_cast<std::size_t>(i)] > nearest[static_cast<std::size_t>(farthest)]) farthest = i;
     }
     next = farthest;
@@ -122,7 +121,8 @@ std::vector<std::vector<int>> spatial_patches(const std::vector<double>& all_res
       int count = 0;
       for (int i = 0; i < n; ++i) {
         if (label[static_cast<std::size_t>(i)] != c) continue;
-        for (int d = 0; d < dimension; ++d) sum[static_cast<std::size_t>(d)] += rest[static_cast<std::size_t>(i * dimension + d)];
+        for (int d = 0; d < dimension; ++d)
+          sum[static_cast<std::size_t>(d)] += rest[static_cast<std::size_t>(i * dimension + d)];
         ++count;
       }
       if (count == 0) continue;
@@ -131,13 +131,16 @@ std::vector<std::vector<int>> spatial_patches(const std::vector<double>& all_res
     }
   }
   std::vector<std::vector<int>> patches(static_cast<std::size_t>(k));
-  for (int i = 0; i < n; ++i) patches[static_cast<std::size_t>(label[static_cast<std::size_t>(i)])].push_back(free_ids[static_cast<std::size_t>(i)]);
+  for (int i = 0; i < n; ++i)
+    patches[static_cast<std::size_t>(label[static_cast<std::size_t>(i)])].push_back(
+        free_ids[static_cast<std::size_t>(i)]);
   for (int a = 0; a < total; ++a) {
     if (is_attached[static_cast<std::size_t>(a)] == 0) continue;
     const std::vector<double> at(all_rest.begin() + a * dimension, all_rest.begin() + (a + 1) * dimension);
     int nearest_free = 0;
     for (int i = 1; i < n; ++i) {
-      if (squared_distance(rest, dimension, i, at) < squared_distance(rest, dimension, nearest_free, at)) nearest_free = i;
+      if (squared_distance(rest, dimension, i, at) < squared_distance(rest, dimension, nearest_free, at))
+        nearest_free = i;
     }
     patches[static_cast<std::size_t>(label[static_cast<std::size_t>(nearest_free)])].push_back(a);
   }
@@ -149,12 +152,12 @@ std::vector<std::vector<int>> spatial_patches(const std::vector<double>& all_res
 
 std::vector<Effect> effect_catalogue(const EffectContext& context) {
   std::vector<Effect> effects;
-  effects.push_back({"plasticity",
-                     {{"yield", 0.0, 0.2, kNoNull, Scale::quadratic, true},
-                      {"creep", 0.0, 40.0, 0.0, Scale::quadratic, true}},
-                     apply_plasticity,
-                     "a yield/creep update of the rest shape (permanent set)",
-                     "a long hold after release: a permanent set stays, viscous recovery continues"});
+  effects.push_back(
+      {"plasticity",
+       {{"yield", 0.0, 0.2, kNoNull, Scale::quadratic, true}, {"creep", 0.0, 40.0, 0.0, Scale::quadratic, true}},
+       apply_plasticity,
+       "a yield/creep update of the rest shape (permanent set)",
+       "a long hold after release: a permanent set stays, viscous recovery continues"});
   effects.push_back({"viscosity",
                      {{"damping", 0.0, 20.0, 0.0, Scale::linear, false},
                       {"relaxation_fraction", 0.0, 0.9, 0.0, Scale::linear, true},
@@ -180,9 +183,7 @@ std::vector<Effect> effect_catalogue(const EffectContext& context) {
     for (std::size_t p = 0; p < context.patches.size(); ++p) {
       patches.push_back({"patch_" + std::to_string(p + 1) + "_msm_beta", 0.0, 1.0, kNoNull, Scale::linear, false});
     }
-    Effect heterogeneity{"heterogeneity",
-                         patches,
-                         apply_heterogeneity,
+    Effect heterogeneity{"heterogeneity", patches, apply_heterogeneity,
                          "regions of different stiffness (msm_beta per patch of the object)",
                          "pressing at a second site: a stiffer or softer region moves with the material"};
     heterogeneity.replaces_beta = true;

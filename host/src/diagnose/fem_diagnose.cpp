@@ -30,13 +30,13 @@ namespace pliant::host {
 namespace {
 
 constexpr int kMinFrames = 10;
-constexpr double kMinImprovement = 0.3;   // held-out misfit must fall by 30 % ...
-constexpr double kMinBicGain = 10.0;      // ... with "very strong" evidence (Kass-Raftery) ...
-constexpr double kMinSignificance = 3.0;  // ... and a parameter 3 std from its null
-constexpr double kMinMisfit = 1.5;        // baseline held-out misfit / noise worth explaining
-constexpr double kUnknownMisfit = 5.0;    // unexplained misfit reported as `unknown`
+constexpr double kMinImprovement = 0.3;     // held-out misfit must fall by 30 % ...
+constexpr double kMinBicGain = 10.0;        // ... with "very strong" evidence (Kass-Raftery) ...
+constexpr double kMinSignificance = 3.0;    // ... and a parameter 3 std from its null
+constexpr double kMinMisfit = 1.5;          // baseline held-out misfit / noise worth explaining
+constexpr double kUnknownMisfit = 5.0;      // unexplained misfit reported as `unknown`
 constexpr double kQuasiStaticRatio = 10.0;  // loading time / lowest period above which statics hold
-constexpr int kMaxSolvedFrames = 40;      // quasi-static: frames solved per simulation, at most about
+constexpr int kMaxSolvedFrames = 40;        // quasi-static: frames solved per simulation, at most about
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
@@ -96,10 +96,7 @@ class FemScorer {
  public:
   FemScorer(const Recording& recording, const FemRecordingSimulator& simulator, std::vector<unsigned char> held_out,
             double position_std, double force_std)
-      : recording_(recording),
-        held_out_(std::move(held_out)),
-        position_std_(position_std),
-        force_std_(force_std) {
+      : recording_(recording), held_out_(std::move(held_out)), position_std_(position_std), force_std_(force_std) {
     const int frames = recording.frame_count();
     const int n = recording.particle_count;
     const std::vector<unsigned char> compared = compared_pairs(recording);
@@ -183,7 +180,8 @@ class FemScorer {
     for (long pair : pairs_) {
       if (held(static_cast<int>(pair / n))) continue;
       for (int d = 0; d < 3; ++d) {
-        const double v = (run.positions[at(pair) * 3 + at(d)] - recording_.positions[at(pair) * 3 + at(d)]) / position_std_;
+        const double v =
+            (run.positions[at(pair) * 3 + at(d)] - recording_.positions[at(pair) * 3 + at(d)]) / position_std_;
         r(row++) = std::isfinite(v) ? v : 0.0;
       }
     }
@@ -221,7 +219,7 @@ class FemScorer {
   std::vector<unsigned char> held_out_;
   double position_std_ = 1;
   double force_std_ = 1;
-  std::vector<long> pairs_;       // compared (frame * n + id) on solved frames
+  std::vector<long> pairs_;        // compared (frame * n + id) on solved frames
   std::vector<int> force_frames_;  // solved frames with a measured force
   std::vector<double> measured_force_;
   long fit_count_ = 0;
@@ -311,7 +309,8 @@ bool forward_levenberg_marquardt(const std::vector<fem::FitParameter>& parameter
       std::vector<double> trial = z;
       for (int a = 0; a < m; ++a) {
         double& v = trial[at(active[at(a)])];
-        v = std::clamp(v + (std::isfinite(delta(a)) ? delta(a) : 0.0), lower[at(active[at(a)])], upper[at(active[at(a)])]);
+        v = std::clamp(v + (std::isfinite(delta(a)) ? delta(a) : 0.0), lower[at(active[at(a)])],
+                       upper[at(active[at(a)])]);
       }
       if (trial == z) break;
       Eigen::VectorXd rt;
@@ -355,10 +354,12 @@ bool forward_levenberg_marquardt(const std::vector<fem::FitParameter>& parameter
       if (largest > 0 && values(k) > 1e-12 * largest) {
         inverse(k) = 1.0 / values(k);
       } else {
-        for (int j = 0; j < p; ++j) undetermined[at(j)] = undetermined[at(j)] || std::abs(eigen.eigenvectors()(j, k)) > 1e-6;
+        for (int j = 0; j < p; ++j)
+          undetermined[at(j)] = undetermined[at(j)] || std::abs(eigen.eigenvectors()(j, k)) > 1e-6;
       }
     }
-    const Eigen::MatrixXd covariance = s2 * eigen.eigenvectors() * inverse.asDiagonal() * eigen.eigenvectors().transpose();
+    const Eigen::MatrixXd covariance =
+        s2 * eigen.eigenvectors() * inverse.asDiagonal() * eigen.eigenvectors().transpose();
     for (int j = 0; j < p; ++j) {
       if (undetermined[at(j)] || !(covariance(j, j) >= 0)) continue;
       const double chain = parameters[at(j)].log_scale ? result.values[at(j)] : 1.0;
@@ -735,7 +736,9 @@ double force_load_sign_change(const FemScorer& scorer, const FemRun& run) {
   const double small = small_sum / small_count;
   const double large = large_sum / large_count;
   const double sigma = scorer.force_std();
-  if (std::abs(small) <= 3.0 * sigma / std::sqrt(small_count) || std::abs(large) <= 3.0 * sigma / std::sqrt(large_count)) return 0.0;
+  if (std::abs(small) <= 3.0 * sigma / std::sqrt(small_count) ||
+      std::abs(large) <= 3.0 * sigma / std::sqrt(large_count))
+    return 0.0;
   if (small * large >= 0) return 0.0;
   return std::min(std::abs(small), std::abs(large)) / std::max(std::abs(small), std::abs(large));
 }
@@ -906,8 +909,8 @@ DiagnoseResult diagnose_recording_fem(const Recording& recording, const Diagnose
   const double position_std = std::max(position_noise, 1e-6 * object_size);
   double peak_force = 0;
   for (const WrenchSample& s : recording.wrench) {
-    peak_force = std::max(peak_force, std::sqrt(s.force_n[0] * s.force_n[0] + s.force_n[1] * s.force_n[1] +
-                                                s.force_n[2] * s.force_n[2]));
+    peak_force = std::max(
+        peak_force, std::sqrt(s.force_n[0] * s.force_n[0] + s.force_n[1] * s.force_n[1] + s.force_n[2] * s.force_n[2]));
   }
   const double force_std = std::max(estimate_force_noise_std(recording), 1e-6 * std::max(peak_force, 1.0));
 
@@ -926,7 +929,8 @@ DiagnoseResult diagnose_recording_fem(const Recording& recording, const Diagnose
   // Baseline E, first quasi-statically; then the time rule.
   report("baseline", 0, 1);
   FemEffectContext context;
-  const double start_youngs = simulator->declared_youngs_modulus_pa() > 0 ? simulator->declared_youngs_modulus_pa() : 1e5;
+  const double start_youngs =
+      simulator->declared_youngs_modulus_pa() > 0 ? simulator->declared_youngs_modulus_pa() : 1e5;
   auto fit_baseline = [&](FemRecordingSimulator& sim, const FemScorer& sc, double youngs) {
     FemFitter fitter(sim, sc, context);
     FemFitter::Evaluation ev = fitter.profile(nullptr, {}, youngs);
@@ -948,7 +952,8 @@ DiagnoseResult diagnose_recording_fem(const Recording& recording, const Diagnose
       fit_options.max_iterations = 15;
       fit_options.difference_step = 1e-3;
       try {
-        const fem::FitResult result = fem::fit_least_squares(parameters, static_cast<int>(sc.fit_count()), function, fit_options);
+        const fem::FitResult result =
+            fem::fit_least_squares(parameters, static_cast<int>(sc.fit_count()), function, fit_options);
         const FemFit f = fitter.finish(nullptr, {}, result.values[0], &result);
         return std::make_pair(f, fitter.simulations);
       } catch (const std::exception&) {
@@ -999,15 +1004,16 @@ DiagnoseResult diagnose_recording_fem(const Recording& recording, const Diagnose
     field = make_residual_field(recording.positions, baseline.run.positions, n, 3);
     out.location = locate_mismatch(field, recording.frame_times_s, position_std);
   } else {
-    out.location = force_location(*scorer, baseline.run, recording.frame_times_s,
-                                  std::vector<int>(recording.wrench_applied_to.begin(), recording.wrench_applied_to.end()));
+    out.location =
+        force_location(*scorer, baseline.run, recording.frame_times_s,
+                       std::vector<int>(recording.wrench_applied_to.begin(), recording.wrench_applied_to.end()));
     std::sort(out.location.particles.begin(), out.location.particles.end());
   }
   std::map<std::string, double> signatures;
   if (positions && solved_stride == 1 && mode == FemTimeMode::quasi_static) {
-    signatures = residual_signatures(recording, fill_frames(baseline.run.positions, recording.frame_times_s, solved,
-                                                            at(n) * 3),
-                                     field, out.location, position_std);
+    signatures =
+        residual_signatures(recording, fill_frames(baseline.run.positions, recording.frame_times_s, solved, at(n) * 3),
+                            field, out.location, position_std);
   }
   if (forces) signatures["force_load_sign_change"] = force_load_sign_change(*scorer, baseline.run);
   signatures["quasi_static"] = mode == FemTimeMode::quasi_static ? 1.0 : 0.0;
@@ -1025,11 +1031,11 @@ DiagnoseResult diagnose_recording_fem(const Recording& recording, const Diagnose
   context.frame_interval_s = duration / std::max(1, (frames - 1) / (context.quasi_static ? stride : 1));
   context.recording_interval_s = duration / std::max(1, frames - 1);
   context.peak_strain = peak_strain(baseline.run, recording, solved);
-  context.lowest_omega_rad_s = std::isfinite(lowest_period) && lowest_period > 0 ? 2.0 * 3.14159265358979323846 / lowest_period : 0.0;
+  context.lowest_omega_rad_s =
+      std::isfinite(lowest_period) && lowest_period > 0 ? 2.0 * 3.14159265358979323846 / lowest_period : 0.0;
   if (positions) {
-    const std::vector<std::vector<int>> patches =
-        spatial_patches(recording.rest_positions, 3, std::max(6, (n - static_cast<int>(recording.fixed.size())) / 8),
-                        recording.fixed);
+    const std::vector<std::vector<int>> patches = spatial_patches(
+        recording.rest_positions, 3, std::max(6, (n - static_cast<int>(recording.fixed.size())) / 8), recording.fixed);
     std::vector<int> node_patch(at(n), 0);
     for (std::size_t p = 0; p < patches.size(); ++p) {
       for (int id : patches[p]) node_patch[at(id)] = static_cast<int>(p);
@@ -1197,8 +1203,7 @@ DiagnoseResult diagnose_recording_fem(const Recording& recording, const Diagnose
       text << " Stress grows faster than strain: the best single modulus is too stiff at small strain and too soft at "
               "large strain; with k = "
            << number(k) << " the modulus at the peak strain " << number(eps) << " is "
-           << number(std::exp(std::min(k * eps * eps, 12.0)))
-           << " times its small-strain value.";
+           << number(std::exp(std::min(k * eps * eps, 12.0))) << " times its small-strain value.";
     } else if (effect.name == "latency") {
       const double tau = f.values[0];
       text << " The wrench stream " << (tau >= 0 ? "lags" : "leads") << " the positions by " << number(std::abs(tau))

@@ -26,7 +26,9 @@ void apply_relaxation_and_damping(const std::vector<double>& v, const FemEffectC
   s.extra_rayleigh_beta = v[2];
 }
 
-void apply_latency(const std::vector<double>& v, const FemEffectContext&, FemRunSettings& s) { s.wrench_latency_s = v[0]; }
+void apply_latency(const std::vector<double>& v, const FemEffectContext&, FemRunSettings& s) {
+  s.wrench_latency_s = v[0];
+}
 
 void apply_gravity(const std::vector<double>& v, const FemEffectContext&, FemRunSettings& s) {
   s.extra_gravity_m_s2 = Eigen::Vector3d(v[0], v[1], v[2]);
@@ -41,7 +43,8 @@ void apply_heterogeneity(const std::vector<double>& v, const FemEffectContext& c
     factor[static_cast<std::size_t>(p)] = v[k++];
   }
   s.element_factor.assign(c.element_patch.size(), 1.0);
-  for (std::size_t e = 0; e < c.element_patch.size(); ++e) s.element_factor[e] = factor[static_cast<std::size_t>(c.element_patch[e])];
+  for (std::size_t e = 0; e < c.element_patch.size(); ++e)
+    s.element_factor[e] = factor[static_cast<std::size_t>(c.element_patch[e])];
 }
 
 void apply_plasticity(const std::vector<double>& v, const FemEffectContext&, FemRunSettings& s) {
@@ -74,16 +77,30 @@ std::vector<FemEffect> fem_effect_catalogue(const FemEffectContext& context) {
       "a hold at constant strain and a second loading rate: relaxation decays in time and scales with rate, latency "
       "and stiffening do not";
   if (context.force_measured && !context.quasi_static) {
-    effects.push_back({"viscosity", {fraction, time, damping}, apply_relaxation_and_damping,
-                       "viscoelastic relaxation of the force and extra stiffness-proportional damping", viscous_experiment,
-                       false, true});
+    effects.push_back({"viscosity",
+                       {fraction, time, damping},
+                       apply_relaxation_and_damping,
+                       "viscoelastic relaxation of the force and extra stiffness-proportional damping",
+                       viscous_experiment,
+                       false,
+                       true});
   } else if (context.force_measured) {
-    effects.push_back({"viscosity", {fraction, time}, apply_relaxation,
-                       "viscoelastic relaxation (an instantaneous modulus (1 + g) E relaxing to E with time constant tau)",
-                       viscous_experiment, false, true});
+    effects.push_back(
+        {"viscosity",
+         {fraction, time},
+         apply_relaxation,
+         "viscoelastic relaxation (an instantaneous modulus (1 + g) E relaxing to E with time constant tau)",
+         viscous_experiment,
+         false,
+         true});
   } else if (!context.quasi_static) {
-    effects.push_back({"viscosity", {damping}, apply_damping, "extra stiffness-proportional (Rayleigh) damping",
-                       viscous_experiment, false, true});
+    effects.push_back({"viscosity",
+                       {damping},
+                       apply_damping,
+                       "extra stiffness-proportional (Rayleigh) damping",
+                       viscous_experiment,
+                       false,
+                       true});
   }
 
   // Latency of the wrench stream.
@@ -95,7 +112,8 @@ std::vector<FemEffect> fem_effect_catalogue(const FemEffectContext& context) {
                        "a time offset of the wrench stream against the positions",
                        "a step or a reversal of the drive: a latency shifts the force by the same time everywhere, "
                        "viscosity rounds it",
-                       false, true});
+                       false,
+                       true});
   }
 
   effects.push_back({"gravity",
@@ -124,7 +142,9 @@ std::vector<FemEffect> fem_effect_catalogue(const FemEffectContext& context) {
                         {"creep", 0.0, std::min(40.0, 2.0 / dt), 0.0, Scale::quadratic, true}},
                        apply_plasticity,
                        "a yield/creep update of the rest shape (permanent set)",
-                       "a long hold after release: a permanent set stays, viscous recovery continues", false, true});
+                       "a long hold after release: a permanent set stays, viscous recovery continues",
+                       false,
+                       true});
   }
   return effects;
 }

@@ -62,12 +62,12 @@ struct FemRecordingSimulator::Impl {
   int n = 0;
   int frames = 0;
   std::vector<unsigned char> solved;
-  std::vector<unsigned char> fitting;    // solved frames a fitting-only run solves
-  std::vector<unsigned char> measured;   // wrench is a measurement in this frame
-  std::vector<unsigned char> loaded;     // wrench is a load in this frame
-  std::vector<double> measured_force;    // frames * 3
-  std::vector<WrenchSample> samples;     // raw wrench stream (latency of loads)
-  std::vector<unsigned char> is_fixed;   // per node
+  std::vector<unsigned char> fitting;   // solved frames a fitting-only run solves
+  std::vector<unsigned char> measured;  // wrench is a measurement in this frame
+  std::vector<unsigned char> loaded;    // wrench is a load in this frame
+  std::vector<double> measured_force;   // frames * 3
+  std::vector<WrenchSample> samples;    // raw wrench stream (latency of loads)
+  std::vector<unsigned char> is_fixed;  // per node
   std::vector<std::vector<int>> node_elements;
   double declared_youngs = 0;
   double tolerance = 1e-12;  // static convergence: largest node step (m)
@@ -98,7 +98,8 @@ struct FemRecordingSimulator::Impl {
     std::size_t k = 0;
     for (std::size_t j = 0; j < frame.driven_nodes.size(); ++j) {
       if (is_fixed[at(frame.driven_nodes[j])] != 0) continue;
-      out.segment<3>(3 * static_cast<Eigen::Index>(k)) = frame.driven_position_m.segment<3>(3 * static_cast<Eigen::Index>(j));
+      out.segment<3>(3 * static_cast<Eigen::Index>(k)) =
+          frame.driven_position_m.segment<3>(3 * static_cast<Eigen::Index>(j));
       ++k;
     }
     return out;
@@ -236,7 +237,8 @@ struct FemRecordingSimulator::Impl {
     rest_centre /= n;
     centre /= n;
     Eigen::Matrix3d cross = Eigen::Matrix3d::Zero();
-    for (int i = 0; i < n; ++i) cross += (x.segment<3>(3 * i) - centre) * (rest.segment<3>(3 * i) - rest_centre).transpose();
+    for (int i = 0; i < n; ++i)
+      cross += (x.segment<3>(3 * i) - centre) * (rest.segment<3>(3 * i) - rest_centre).transpose();
     const Eigen::Matrix3d rotation = fem::polar_rotation(cross);
     const double alpha = std::min(1.0, settings.plastic_creep * dt);
     Eigen::VectorXd next = rest;
@@ -484,7 +486,7 @@ FemRun FemRecordingSimulator::simulate(const FemRunSettings& settings, bool fitt
 }
 
 FemRecordingSimulator::ElasticRun FemRecordingSimulator::Impl::elastic_run(const FemRunSettings& settings,
-                                                                            const std::vector<unsigned char>& solve) {
+                                                                           const std::vector<unsigned char>& solve) {
   Impl& im = *this;
   ElasticRun run;
   run.positions.assign(at(im.frames) * at(im.n) * 3, kNaN);

@@ -20,7 +20,8 @@ double residual_rms(const std::vector<double>& observed, const std::vector<doubl
                     int dimension, const std::vector<unsigned char>& frame_mask, unsigned char wanted,
                     const std::vector<unsigned char>* particle_mask) {
   if (dimension < 1 || particle_count < 0) throw std::invalid_argument("residual_rms: bad dimension or particle count");
-  if (observed.size() != simulated.size()) throw std::invalid_argument("residual_rms: observed and simulated differ in size");
+  if (observed.size() != simulated.size())
+    throw std::invalid_argument("residual_rms: observed and simulated differ in size");
   if (particle_count == 0) {
     if (!observed.empty()) throw std::invalid_argument("residual_rms: positions given for zero particles");
     return 0.0;

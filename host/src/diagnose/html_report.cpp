@@ -64,8 +64,7 @@ struct Shape {
 Shape shape_of(const DiagnosisEvidence& evidence) {
   Shape shape;
   shape.frames = evidence.frame_times_s.size();
-  shape.particles =
-      evidence.particle_count > 0 ? static_cast<std::size_t>(evidence.particle_count) : 0;
+  shape.particles = evidence.particle_count > 0 ? static_cast<std::size_t>(evidence.particle_count) : 0;
   shape.dimension = evidence.dimension > 0 ? static_cast<std::size_t>(evidence.dimension) : 0;
   shape.times_monotonic = shape.frames > 0;
   for (std::size_t f = 0; f < shape.frames; ++f) {
@@ -113,8 +112,7 @@ Grid grid_for(const Shape& shape) {
   grid.particles = shape.particles;
   grid.rows = std::min(shape.particles, kMaxRows);
   grid.cols = shape.frames;
-  if (grid.rows * grid.cols > kMaxCells)
-    grid.cols = std::max<std::size_t>(1, kMaxCells / grid.rows);
+  if (grid.rows * grid.cols > kMaxCells) grid.cols = std::max<std::size_t>(1, kMaxCells / grid.rows);
   return grid;
 }
 
@@ -187,8 +185,8 @@ struct MapPanel {
   const std::vector<double>* cells = nullptr;
 };
 
-void draw_map(std::string& out, const MapPanel& panel, const Grid& grid, const Scale& scale,
-              const Diagnosis& diagnosis, const DiagnosisEvidence& evidence, const Shape& shape) {
+void draw_map(std::string& out, const MapPanel& panel, const Grid& grid, const Scale& scale, const Diagnosis& diagnosis,
+              const DiagnosisEvidence& evidence, const Shape& shape) {
   const double map_w = 560;
   const double map_h = std::clamp(static_cast<double>(grid.rows) * 6.0, 160.0, 420.0);
   const double left = 74, top = 52;
@@ -218,9 +216,8 @@ void draw_map(std::string& out, const MapPanel& panel, const Grid& grid, const S
          std::string(svg::kMissingGrey) +
          "\"/><line x1=\"0\" y1=\"0\" x2=\"0\" y2=\"6\" stroke=\"#a6a6a6\" "
          "stroke-width=\"2\"/></pattern></defs>\n";
-  out += "<rect x=\"" + svg::coord(left) + "\" y=\"" + svg::coord(top) + "\" width=\"" +
-         svg::coord(map_w) + "\" height=\"" + svg::coord(map_h) + "\" fill=\"url(#" +
-         escape(hatch) + ")\"/>\n";
+  out += "<rect x=\"" + svg::coord(left) + "\" y=\"" + svg::coord(top) + "\" width=\"" + svg::coord(map_w) +
+         "\" height=\"" + svg::coord(map_h) + "\" fill=\"url(#" + escape(hatch) + ")\"/>\n";
 
   // Cells: one path per colour level, each horizontal run of equal level one stroked segment
   // in cell units (the transform scales a unit stroke to the cell height).
@@ -256,10 +253,9 @@ void draw_map(std::string& out, const MapPanel& panel, const Grid& grid, const S
       c = end;
     }
   }
-  out +=
-      "<g fill=\"none\" stroke-width=\"1\" shape-rendering=\"crispEdges\" transform=\"translate(" +
-      svg::coord(left) + " " + svg::coord(top + ch / 2) + ") scale(" + std::to_string(cw) + " " +
-      std::to_string(ch) + ")\">\n";
+  out += "<g fill=\"none\" stroke-width=\"1\" shape-rendering=\"crispEdges\" transform=\"translate(" +
+         svg::coord(left) + " " + svg::coord(top + ch / 2) + ") scale(" + std::to_string(cw) + " " +
+         std::to_string(ch) + ")\">\n";
   for (int level = 0; level < kLevels; ++level) {
     const std::string& d = runs[static_cast<std::size_t>(level)];
     if (d.empty()) continue;
@@ -285,9 +281,9 @@ void draw_map(std::string& out, const MapPanel& panel, const Grid& grid, const S
       }
       std::size_t end = c + 1;
       while (end < grid.cols && held(end)) ++end;
-      strip += "M" + svg::coord(left + static_cast<double>(c) * cw) + " " + svg::coord(top - 10) +
-               "h" + svg::coord(static_cast<double>(end - c) * cw) + "v7h" +
-               svg::coord(-static_cast<double>(end - c) * cw) + "z";
+      strip += "M" + svg::coord(left + static_cast<double>(c) * cw) + " " + svg::coord(top - 10) + "h" +
+               svg::coord(static_cast<double>(end - c) * cw) + "v7h" + svg::coord(-static_cast<double>(end - c) * cw) +
+               "z";
       c = end;
     }
     if (!strip.empty()) {
@@ -317,8 +313,7 @@ void draw_map(std::string& out, const MapPanel& panel, const Grid& grid, const S
       const double y0 = area.py(std::floor(static_cast<double>(first_id) * scale_y));
       const double y1 = area.py(std::floor(static_cast<double>(last_id) * scale_y) + 1);
       out += "<rect x=\"" + svg::coord(x0) + "\" y=\"" + svg::coord(y0) + "\" width=\"" +
-             svg::coord(std::max(x1 - x0, 1.0)) + "\" height=\"" +
-             svg::coord(std::max(y1 - y0, 1.0)) +
+             svg::coord(std::max(x1 - x0, 1.0)) + "\" height=\"" + svg::coord(std::max(y1 - y0, 1.0)) +
              "\" fill=\"none\" stroke=\"#ffffff\" stroke-width=\"1.5\" "
              "stroke-dasharray=\"5 3\"/>\n";
     }
@@ -331,15 +326,13 @@ void draw_map(std::string& out, const MapPanel& panel, const Grid& grid, const S
     marks += "M" + svg::coord(left + map_w + 1) + " " + svg::coord(y) + "l6 -3v6z";
     ++marked;
   }
-  if (!marks.empty())
-    out += "<path fill=\"" + std::string(kHeldOutColour) + "\" d=\"" + marks + "\"/>\n";
+  if (!marks.empty()) out += "<path fill=\"" + std::string(kHeldOutColour) + "\" d=\"" + marks + "\"/>\n";
 
   // Axes: time (or frame number) along x, particle id along y.
   svg::Ticks x_ticks;
   std::string x_label;
   if (shape.times_monotonic) {
-    const svg::Ticks t =
-        svg::linear_ticks(evidence.frame_times_s.front(), evidence.frame_times_s.back(), 6);
+    const svg::Ticks t = svg::linear_ticks(evidence.frame_times_s.front(), evidence.frame_times_s.back(), 6);
     for (std::size_t i = 0; i < t.at.size(); ++i) {
       x_ticks.at.push_back((frame_of_time(evidence.frame_times_s, t.at[i]) + 0.5) * scale_x);
       x_ticks.labels.push_back(t.labels[i]);
@@ -357,17 +350,15 @@ void draw_map(std::string& out, const MapPanel& panel, const Grid& grid, const S
   const svg::Ticks ids = svg::linear_ticks(0, static_cast<double>(grid.particles - 1), 6);
   for (std::size_t i = 0; i < ids.at.size(); ++i) {
     if (ids.at[i] != std::floor(ids.at[i])) continue;
-    y_ticks.at.push_back((ids.at[i] + 0.5) * static_cast<double>(grid.rows) /
-                         static_cast<double>(grid.particles));
+    y_ticks.at.push_back((ids.at[i] + 0.5) * static_cast<double>(grid.rows) / static_cast<double>(grid.particles));
     y_ticks.labels.push_back(ids.labels[i]);
   }
   svg::axes(out, area, x_ticks, y_ticks, x_label, "particle id");
-  svg::colour_bar(out, left + map_w + 26, top, 14, map_h, 0.0, scale.top, kLevels,
-                  "mean |residual| (" + unit + ")", scale.clamped);
+  svg::colour_bar(out, left + map_w + 26, top, 14, map_h, 0.0, scale.top, kLevels, "mean |residual| (" + unit + ")",
+                  scale.clamped);
   // Legend for missing data.
   out += "<rect x=\"" + svg::coord(left) + "\" y=\"" + svg::coord(top - 24) +
-         "\" width=\"12\" height=\"10\" fill=\"url(#" + escape(hatch) +
-         ")\" stroke=\"#a6a6a6\"/>\n";
+         "\" width=\"12\" height=\"10\" fill=\"url(#" + escape(hatch) + ")\" stroke=\"#a6a6a6\"/>\n";
   svg::text(out, left + 16, top - 15, "unobserved");
   svg::text(out, left + 96, top - 15, "dashed box: location window; red ticks: located particles");
   svg::close(out);
@@ -382,8 +373,8 @@ struct Series {
   bool present = false;
 };
 
-Series component(const std::vector<double>& track, const Shape& shape, std::size_t id,
-                 std::size_t axis, double origin) {
+Series component(const std::vector<double>& track, const Shape& shape, std::size_t id, std::size_t axis,
+                 double origin) {
   Series series;
   if (!shape.has_track(track)) return series;
   series.present = true;
@@ -396,8 +387,8 @@ Series component(const std::vector<double>& track, const Shape& shape, std::size
 }
 
 // Long series keep, per bucket, the smallest and largest value in time order, so spikes stay.
-void decimate(const std::vector<double>& xs, const std::vector<double>& ys,
-              std::vector<double>& out_x, std::vector<double>& out_y) {
+void decimate(const std::vector<double>& xs, const std::vector<double>& ys, std::vector<double>& out_x,
+              std::vector<double>& out_y) {
   const std::size_t n = std::min(xs.size(), ys.size());
   if (n <= kMaxLinePoints) {
     out_x.assign(xs.begin(), xs.begin() + static_cast<std::ptrdiff_t>(n));
@@ -429,8 +420,8 @@ void decimate(const std::vector<double>& xs, const std::vector<double>& ys,
   }
 }
 
-void draw_trajectory(std::string& out, std::size_t id, const Diagnosis& diagnosis,
-                     const DiagnosisEvidence& evidence, const Shape& shape) {
+void draw_trajectory(std::string& out, std::size_t id, const Diagnosis& diagnosis, const DiagnosisEvidence& evidence,
+                     const Shape& shape) {
   const std::string unit = unit_of(evidence);
   const auto at = [&](const std::vector<double>& track, std::size_t f, std::size_t axis) {
     return track[(f * shape.particles + id) * shape.dimension + axis];
@@ -495,8 +486,8 @@ void draw_trajectory(std::string& out, std::size_t id, const Diagnosis& diagnosi
   lo -= pad;
   hi += pad;
 
-  const std::string title = "Particle " + std::to_string(id) + ": displacement along " +
-                            std::string(1, axis_name) + " from its first position";
+  const std::string title = "Particle " + std::to_string(id) + ": displacement along " + std::string(1, axis_name) +
+                            " from its first position";
   const double width = 380, height = 250;
   svg::open(out, "trajectory_" + std::to_string(id), title, width, height);
   svg::text(out, 70, 16, "particle " + std::to_string(id), "font-size=\"13\" font-weight=\"bold\"");
@@ -512,13 +503,12 @@ void draw_trajectory(std::string& out, std::size_t id, const Diagnosis& diagnosi
 
   const Location& location = diagnosis.location;
   if (shape.times_monotonic && std::isfinite(location.t_start) && std::isfinite(location.t_end) &&
-      location.t_end >= location.t_start && location.t_end >= area.x_min &&
-      location.t_start <= area.x_max) {
+      location.t_end >= location.t_start && location.t_end >= area.x_min && location.t_start <= area.x_max) {
     const double x0 = area.px(std::max(location.t_start, area.x_min));
     const double x1 = area.px(std::min(location.t_end, area.x_max));
     out += "<rect x=\"" + svg::coord(x0) + "\" y=\"" + svg::coord(area.top) + "\" width=\"" +
-           svg::coord(std::max(x1 - x0, 1.0)) + "\" height=\"" + svg::coord(area.height) +
-           "\" fill=\"" + kWindowColour + "\" fill-opacity=\"0.35\"/>\n";
+           svg::coord(std::max(x1 - x0, 1.0)) + "\" height=\"" + svg::coord(area.height) + "\" fill=\"" +
+           kWindowColour + "\" fill-opacity=\"0.35\"/>\n";
   }
   const auto line = [&](const Series& s, const std::string& attributes) {
     if (!s.present) return;
@@ -527,12 +517,11 @@ void draw_trajectory(std::string& out, std::size_t id, const Diagnosis& diagnosi
     svg::polyline(out, area, dx, dy, attributes);
   };
   line(observed, "stroke=\"" + std::string(kObservedColour) + "\" stroke-width=\"2.2\"");
-  line(baseline, "stroke=\"" + std::string(kBaselineColour) +
-                     "\" stroke-width=\"1.5\" stroke-dasharray=\"6 3\"");
+  line(baseline, "stroke=\"" + std::string(kBaselineColour) + "\" stroke-width=\"1.5\" stroke-dasharray=\"6 3\"");
   line(augmented, "stroke=\"" + std::string(kAugmentedColour) + "\" stroke-width=\"1.5\"");
   if (!any) {
-    svg::text(out, area.left + area.width / 2, area.top + area.height / 2,
-              "never observed or simulated", "text-anchor=\"middle\" fill=\"#888888\"");
+    svg::text(out, area.left + area.width / 2, area.top + area.height / 2, "never observed or simulated",
+              "text-anchor=\"middle\" fill=\"#888888\"");
   }
   svg::axes(out, area, svg::linear_ticks(area.x_min, area.x_max, 5), svg::linear_ticks(lo, hi, 5),
             shape.times_monotonic ? "time (s)" : "frame (times not monotonic)",
@@ -543,8 +532,8 @@ void draw_trajectory(std::string& out, std::size_t id, const Diagnosis& diagnosi
 // ------------------------------------------------------------------------------------------
 // Page
 
-std::string with_std(const std::map<std::string, double>& values,
-                     const std::map<std::string, double>& stds, const std::string& name) {
+std::string with_std(const std::map<std::string, double>& values, const std::map<std::string, double>& stds,
+                     const std::string& name) {
   const auto v = values.find(name);
   if (v == values.end()) return "&mdash;";
   std::string text = escape(number(v->second, 4));
@@ -553,8 +542,7 @@ std::string with_std(const std::map<std::string, double>& values,
   return text;
 }
 
-std::string parameter_list(const std::map<std::string, double>& values,
-                           const std::map<std::string, double>& stds) {
+std::string parameter_list(const std::map<std::string, double>& values, const std::map<std::string, double>& stds) {
   if (values.empty()) return "&mdash;";
   std::string text;
   for (const auto& entry : values) {
@@ -599,12 +587,10 @@ svg.plot { display: block; max-width: 100%; height: auto; border: 1px solid #e3e
 void header(std::string& out, const Diagnosis& d, const DiagnosisEvidence& evidence) {
   const std::string unit = escape(unit_of(evidence));
   out += "<h1>Diagnosis of <code>" + escape(d.recording) + "</code></h1>\n";
-  out += "<p><span class=\"verdict verdict-" + escape(d.verdict) + "\" data-field=\"verdict\">" +
-         escape(d.verdict) + "</span> &nbsp; effect: <strong data-field=\"effect\">" +
-         escape(d.effect) + "</strong></p>\n";
+  out += "<p><span class=\"verdict verdict-" + escape(d.verdict) + "\" data-field=\"verdict\">" + escape(d.verdict) +
+         "</span> &nbsp; effect: <strong data-field=\"effect\">" + escape(d.effect) + "</strong></p>\n";
   if (!d.explanation.empty()) {
-    out +=
-        "<p class=\"explanation\" data-field=\"explanation\">" + escape(d.explanation) + "</p>\n";
+    out += "<p class=\"explanation\" data-field=\"explanation\">" + escape(d.explanation) + "</p>\n";
   }
   out += "<table data-table=\"summary\">\n";
   const auto row = [&](const std::string& name, const std::string& value) {
@@ -613,17 +599,17 @@ void header(std::string& out, const Diagnosis& d, const DiagnosisEvidence& evide
   // FEM on a force-only recording: no free node position is compared, the force rows say it all.
   const bool force_only = !std::isfinite(d.baseline.rms) && std::isfinite(d.baseline.force_rms);
   if (force_only) {
-    row("model", "<code>" + escape(d.baseline.model) + "</code> &nbsp; (no free node position is compared: "
-                 "the evidence is the force)");
+    row("model", "<code>" + escape(d.baseline.model) +
+                     "</code> &nbsp; (no free node position is compared: "
+                     "the evidence is the force)");
   } else {
     row("measurement noise rms", escape(number(d.noise_rms, 3)) + " " + unit);
-    row("baseline rms (held-out)", escape(number(d.baseline.rms, 3)) + " " + unit +
-                                       " &nbsp; (model <code>" + escape(d.baseline.model) +
-                                       "</code>)");
+    row("baseline rms (held-out)", escape(number(d.baseline.rms, 3)) + " " + unit + " &nbsp; (model <code>" +
+                                       escape(d.baseline.model) + "</code>)");
     row("augmented rms (held-out)", escape(number(d.augmented.rms, 3)) + " " + unit);
   }
-  row("improvement", std::isfinite(d.improvement) ? escape(number(100.0 * d.improvement, 3)) + " %"
-                                                  : std::string("n/a"));
+  row("improvement",
+      std::isfinite(d.improvement) ? escape(number(100.0 * d.improvement, 3)) + " %" : std::string("n/a"));
   if (d.noise_rms > 0 && std::isfinite(d.baseline.rms)) {
     row("baseline rms / noise", escape(number(d.baseline.rms / d.noise_rms, 3)));
   }
@@ -634,18 +620,17 @@ void header(std::string& out, const Diagnosis& d, const DiagnosisEvidence& evide
   }
   row("located particles", id_list(d.location.particles));
   if (!d.location.particles.empty()) {
-    row("location window", escape(number(d.location.t_start, 4)) + " s &ndash; " +
-                               escape(number(d.location.t_end, 4)) + " s");
+    row("location window",
+        escape(number(d.location.t_start, 4)) + " s &ndash; " + escape(number(d.location.t_end, 4)) + " s");
   }
   row("recording", escape(std::to_string(evidence.frame_times_s.size())) + " frames, " +
                        escape(std::to_string(evidence.particle_count)) + " particles, " +
-                       escape(std::to_string(evidence.dimension)) + "D; fixed: " +
-                       id_list(evidence.fixed) + "; driven: " + id_list(evidence.driven));
+                       escape(std::to_string(evidence.dimension)) + "D; fixed: " + id_list(evidence.fixed) +
+                       "; driven: " + id_list(evidence.driven));
   out += "</table>\n";
 }
 
-void maps_section(std::string& out, const Diagnosis& d, const DiagnosisEvidence& evidence,
-                  const Shape& shape) {
+void maps_section(std::string& out, const Diagnosis& d, const DiagnosisEvidence& evidence, const Shape& shape) {
   out += "<h2>Residual maps</h2>\n";
   const bool consistent = d.verdict == "consistent";
   const bool have_before = shape.has_map(evidence.residual_baseline);
@@ -662,18 +647,15 @@ void maps_section(std::string& out, const Diagnosis& d, const DiagnosisEvidence&
     return;
   }
   const Grid grid = grid_for(shape);
-  const std::vector<double> before =
-      have_before ? bin_map(evidence.residual_baseline, grid) : std::vector<double>();
-  const std::vector<double> after =
-      have_after ? bin_map(*after_source, grid) : std::vector<double>();
+  const std::vector<double> before = have_before ? bin_map(evidence.residual_baseline, grid) : std::vector<double>();
+  const std::vector<double> after = have_after ? bin_map(*after_source, grid) : std::vector<double>();
   const Scale scale = shared_scale(before, after, d.noise_rms);
   out +=
       "<p>|observed &minus; simulated| per particle and frame, on one colour scale for both "
       "maps (" +
       escape(unit_of(evidence)) + ").";
   if (grid.binned()) {
-    out += " The recording has " + std::to_string(shape.frames) + " frames &times; " +
-           std::to_string(shape.particles) +
+    out += " The recording has " + std::to_string(shape.frames) + " frames &times; " + std::to_string(shape.particles) +
            " particles; each cell shows the mean over a block "
            "of about " +
            std::to_string((shape.frames + grid.cols - 1) / grid.cols) + " frames &times; " +
@@ -681,30 +663,28 @@ void maps_section(std::string& out, const Diagnosis& d, const DiagnosisEvidence&
   }
   out += "</p>\n<div class=\"plots\">\n";
   if (have_before) {
-    draw_map(out,
-             {"residual_before",
-              "(a) before: baseline " + d.baseline.model + ", rms " + number(d.baseline.rms, 3) +
-                  " " + unit_of(evidence),
-              &before},
-             grid, scale, d, evidence, shape);
+    draw_map(
+        out,
+        {"residual_before",
+         "(a) before: baseline " + d.baseline.model + ", rms " + number(d.baseline.rms, 3) + " " + unit_of(evidence),
+         &before},
+        grid, scale, d, evidence, shape);
   } else {
     out += "<p class=\"note\">No baseline residual map (array size mismatch).</p>\n";
   }
   if (have_after) {
-    draw_map(out,
-             {"residual_after",
-              "(b) after: baseline + " + d.effect + ", rms " + number(d.augmented.rms, 3) + " " +
-                  unit_of(evidence),
-              &after},
-             grid, scale, d, evidence, shape);
+    draw_map(
+        out,
+        {"residual_after",
+         "(b) after: baseline + " + d.effect + ", rms " + number(d.augmented.rms, 3) + " " + unit_of(evidence), &after},
+        grid, scale, d, evidence, shape);
   } else {
     out += "<p class=\"note\">No augmented residual map (array size mismatch).</p>\n";
   }
   out += "</div>\n";
 }
 
-void trajectories_section(std::string& out, const Diagnosis& d, const DiagnosisEvidence& evidence,
-                          const Shape& shape) {
+void trajectories_section(std::string& out, const Diagnosis& d, const DiagnosisEvidence& evidence, const Shape& shape) {
   out += "<h2>(c) Trajectories of the located particles</h2>\n";
   if (!shape.has_track(evidence.observed)) {
     out +=
@@ -729,17 +709,15 @@ void trajectories_section(std::string& out, const Diagnosis& d, const DiagnosisE
   out +=
       "<p class=\"legend\">Displacement from the first observed position along the axis in "
       "which the particle moves most. <span style=\"color:" +
-      std::string(kObservedColour) +
-      "\">&#9473; observed</span><span style=\"color:" + kBaselineColour +
+      std::string(kObservedColour) + "\">&#9473; observed</span><span style=\"color:" + kBaselineColour +
       "\">&#9476; baseline</span><span style=\"color:" + kAugmentedColour +
       "\">&#9473; augmented</span><span style=\"background:" + kWindowColour +
       "\">&nbsp;location window&nbsp;</span></p>\n";
   if (seen.size() > ids.size()) {
-    out += "<p class=\"note\">Showing the first " + std::to_string(ids.size()) + " of " +
-           std::to_string(seen.size()) + " located particles.</p>\n";
+    out += "<p class=\"note\">Showing the first " + std::to_string(ids.size()) + " of " + std::to_string(seen.size()) +
+           " located particles.</p>\n";
   }
-  if (!shape.has_track(evidence.simulated_baseline) ||
-      !shape.has_track(evidence.simulated_augmented)) {
+  if (!shape.has_track(evidence.simulated_baseline) || !shape.has_track(evidence.simulated_augmented)) {
     out += "<p class=\"note\">Some simulated trajectories are missing and are not drawn.</p>\n";
   }
   out += "<div class=\"plots\">\n";
@@ -796,11 +774,13 @@ void force_section(std::string& out, const Diagnosis& d, const DiagnosisEvidence
   const double pad = hi > lo ? 0.05 * (hi - lo) : std::max(std::fabs(hi) * 0.1, 1e-9);
   lo -= pad;
   hi += pad;
-  out += "<p class=\"legend\">Force of the tool on the object along the direction of the largest measured force "
-         "(" + escape(number(direction[0], 3)) + ", " + escape(number(direction[1], 3)) + ", " +
-         escape(number(direction[2], 3)) + "). <span style=\"color:" + std::string(kObservedColour) +
-         "\">&#9473; measured</span><span style=\"color:" + kBaselineColour +
-         "\">&#9476; baseline</span><span style=\"color:" + kAugmentedColour + "\">&#9473; augmented</span></p>\n";
+  out +=
+      "<p class=\"legend\">Force of the tool on the object along the direction of the largest measured force "
+      "(" +
+      escape(number(direction[0], 3)) + ", " + escape(number(direction[1], 3)) + ", " +
+      escape(number(direction[2], 3)) + "). <span style=\"color:" + std::string(kObservedColour) +
+      "\">&#9473; measured</span><span style=\"color:" + kBaselineColour +
+      "\">&#9476; baseline</span><span style=\"color:" + kAugmentedColour + "\">&#9473; augmented</span></p>\n";
   const double width = 760, height = 320;
   svg::open(out, "force", "Measured and simulated force against time", width, height);
   svg::Area area;
@@ -841,10 +821,10 @@ void tables_section(std::string& out, const Diagnosis& d, const DiagnosisEvidenc
     for (std::size_t i = 0; i < d.candidates.size(); ++i) {
       const Candidate& c = d.candidates[i];
       const bool chosen = d.verdict != "consistent" && c.effect == d.effect;
-      out += std::string(chosen ? "<tr class=\"chosen\">" : "<tr>") + "<td class=\"num\">" +
-             std::to_string(i + 1) + "</td><td>" + escape(c.effect) + (chosen ? " (chosen)" : "") +
-             "</td><td class=\"num\">" + escape(number(c.rms, 3)) +
-             "</td>" + (forces ? "<td class=\"num\">" + escape(number(c.force_rms, 3)) + "</td>" : std::string()) +
+      out += std::string(chosen ? "<tr class=\"chosen\">" : "<tr>") + "<td class=\"num\">" + std::to_string(i + 1) +
+             "</td><td>" + escape(c.effect) + (chosen ? " (chosen)" : "") + "</td><td class=\"num\">" +
+             escape(number(c.rms, 3)) + "</td>" +
+             (forces ? "<td class=\"num\">" + escape(number(c.force_rms, 3)) + "</td>" : std::string()) +
              "<td class=\"num\">" + escape(number(c.bic, 6)) + "</td><td>" +
              parameter_list(c.parameters, c.parameter_std) + "</td></tr>\n";
     }
@@ -875,17 +855,13 @@ void tables_section(std::string& out, const Diagnosis& d, const DiagnosisEvidenc
         if (delta == 0) {
           shift = "unchanged";
         } else if (b->second != 0 && std::isfinite(delta)) {
-          shift +=
-              " (" +
-              escape((delta >= 0 ? "+" : "") + number(100.0 * delta / std::fabs(b->second), 3)) +
-              " %)";
+          shift += " (" + escape((delta >= 0 ? "+" : "") + number(100.0 * delta / std::fabs(b->second), 3)) + " %)";
         }
       }
       out += "<tr><td><code>" + escape(name) + "</code></td><td class=\"num\">" +
-             with_std(d.baseline.parameters, d.baseline.parameter_std, name) +
-             "</td><td class=\"num\">" +
-             with_std(d.augmented.parameters, d.augmented.parameter_std, name) +
-             "</td><td class=\"num\">" + shift + "</td></tr>\n";
+             with_std(d.baseline.parameters, d.baseline.parameter_std, name) + "</td><td class=\"num\">" +
+             with_std(d.augmented.parameters, d.augmented.parameter_std, name) + "</td><td class=\"num\">" + shift +
+             "</td></tr>\n";
     }
     out += "</table>\n";
   }
@@ -896,8 +872,8 @@ void tables_section(std::string& out, const Diagnosis& d, const DiagnosisEvidenc
   } else {
     out += "<table data-table=\"signatures\">\n<tr><th>signature</th><th>value</th></tr>\n";
     for (const auto& s : evidence.signatures) {
-      out += "<tr><td><code>" + escape(s.first) + "</code></td><td class=\"num\">" +
-             escape(number(s.second, 4)) + "</td></tr>\n";
+      out += "<tr><td><code>" + escape(s.first) + "</code></td><td class=\"num\">" + escape(number(s.second, 4)) +
+             "</td></tr>\n";
     }
     out += "</table>\n";
   }
@@ -926,15 +902,15 @@ std::string diagnosis_html(const Diagnosis& diagnosis, const DiagnosisEvidence& 
   header(out, diagnosis, evidence);
   if (shape.frames == 0 || shape.particles == 0) {
     out += "<p class=\"note\" data-note=\"no-data\">No data to plot: the evidence holds " +
-           std::to_string(shape.frames) + " frames and " + std::to_string(shape.particles) +
-           " particles.</p>\n";
+           std::to_string(shape.frames) + " frames and " + std::to_string(shape.particles) + " particles.</p>\n";
   } else {
     force_section(out, diagnosis, evidence);
     // Force only (FEM, no free node position compared): the maps and trajectories would show
     // constrained nodes that follow their own observations, so they are left out.
     if (!std::isfinite(diagnosis.baseline.rms) && !evidence.force_observed.empty()) {
-      out += "<p class=\"note\" data-note=\"force-only\">No residual maps or trajectories: no free node "
-             "position is compared with the simulation; the force above is the evidence.</p>\n";
+      out +=
+          "<p class=\"note\" data-note=\"force-only\">No residual maps or trajectories: no free node "
+          "position is compared with the simulation; the force above is the evidence.</p>\n";
     } else {
       maps_section(out, diagnosis, evidence, shape);
       trajectories_section(out, diagnosis, evidence, shape);
@@ -960,8 +936,8 @@ void write_diagnosis_report(const Diagnosis& diagnosis, const DiagnosisEvidence&
   const fs::path final_path = dir / "index.html";
   // Unique per process and call, so concurrent writers never share a temporary file.
   static std::atomic<unsigned> serial{0};
-  const fs::path temporary = dir / (".index.html." + std::to_string(::getpid()) + "." +
-                                    std::to_string(serial.fetch_add(1)) + ".tmp");
+  const fs::path temporary =
+      dir / (".index.html." + std::to_string(::getpid()) + "." + std::to_string(serial.fetch_add(1)) + ".tmp");
   {
     errno = 0;
     std::ofstream file(temporary, std::ios::binary | std::ios::trunc);
@@ -979,8 +955,7 @@ void write_diagnosis_report(const Diagnosis& diagnosis, const DiagnosisEvidence&
     const std::string cause = error.message();
     std::error_code ignored;
     fs::remove(temporary, ignored);
-    throw std::runtime_error("cannot move the report into place at " +
-                             one_line(final_path.string()) + ": " + cause);
+    throw std::runtime_error("cannot move the report into place at " + one_line(final_path.string()) + ": " + cause);
   }
 }
 

@@ -11,15 +11,15 @@
 namespace pliant::host {
 namespace {
 
-constexpr double kNoiseFloor = 1e-9;     // noise-free input: this fraction of the scale
-constexpr double kSignificance = 3.0;    // z for every "significant" test of the signatures
-constexpr int kRestFrames = 5;           // frames averaged for a driver's final position
-constexpr int kSupportRestFrames = 10;   // frames averaged for a support particle's rest
+constexpr double kNoiseFloor = 1e-9;    // noise-free input: this fraction of the scale
+constexpr double kSignificance = 3.0;   // z for every "significant" test of the signatures
+constexpr int kRestFrames = 5;          // frames averaged for a driver's final position
+constexpr int kSupportRestFrames = 10;  // frames averaged for a support particle's rest
 // Gate for pooled mean squares of few samples (skewed, chi-square-like): 4 standard deviations.
 constexpr double kSmallSampleSignificance = 4.0;
-constexpr double kTailFraction = 0.2;    // persistence: last 20% of the frames after unloading
-constexpr int kVelocityHalfWindow = 2;   // velocities: slope over 5 frames
-constexpr int kPeakHalfWindow = 2;       // persistence: peak of a 5-frame pooled mean square
+constexpr double kTailFraction = 0.2;   // persistence: last 20% of the frames after unloading
+constexpr int kVelocityHalfWindow = 2;  // velocities: slope over 5 frames
+constexpr int kPeakHalfWindow = 2;      // persistence: peak of a 5-frame pooled mean square
 // velocity_correlation: samples * R^2 must exceed 10 + 3 * dim (white noise: p < 1e-3).
 constexpr double kChiSquareGate = 10.0;
 constexpr double kChiSquarePerDof = 3.0;
@@ -56,7 +56,8 @@ double floored_noise(double noise_std, double scale) {
 }
 
 void check_recording(const Recording& recording) {
-  if (recording.dimension < 1 || recording.particle_count < 0) throw std::invalid_argument("bad dimension or particle count");
+  if (recording.dimension < 1 || recording.particle_count < 0)
+    throw std::invalid_argument("bad dimension or particle count");
   if (recording.positions.size() != at(recording.frame_count(), 0, recording.particle_count, recording.dimension)) {
     throw std::invalid_argument("recording positions size does not match frames * particles * dimension");
   }
@@ -110,7 +111,8 @@ std::vector<double> rest_of(const Recording& recording) {
   const int dim = recording.dimension;
   const std::size_t size = at(1, 0, n, dim);
   if (recording.rest_positions.size() == size &&
-      std::all_of(recording.rest_positions.begin(), recording.rest_positions.end(), [](double v) { return std::isfinite(v); })) {
+      std::all_of(recording.rest_positions.begin(), recording.rest_positions.end(),
+                  [](double v) { return std::isfinite(v); })) {
     return recording.rest_positions;
   }
   std::vector<double> rest(size, std::nan(""));
@@ -170,7 +172,8 @@ int unload_frame(const Recording& recording, double noise) {
       for (int d = 0; d < dim; ++d) final_position[static_cast<std::size_t>(d)] += p[d] / static_cast<double>(tail);
     }
     double travel = 0;
-    for (int k : driven_frames) travel = std::max(travel, std::sqrt(squared(observed_point(recording, k, id), final_position.data(), dim)));
+    for (int k : driven_frames)
+      travel = std::max(travel, std::sqrt(squared(observed_point(recording, k, id), final_position.data(), dim)));
     const double threshold = std::max(3.0 * noise * std::sqrt(dim), 0.01 * travel);
     int settled = driven_frames.front();
     for (int k : driven_frames) {
@@ -185,7 +188,8 @@ int unload_frame(const Recording& recording, double noise) {
 // Velocity of particle `id` at frame k of a frame-major array: least-squares slope over its
 // finite samples in frames k-2..k+2 on real times (noise std about s / (3.2 dt), a third of a
 // frame difference's). False when fewer than two samples span a positive time.
-bool velocity_at(const std::vector<double>& positions, const Recording& recording, int k, int id, std::vector<double>& out) {
+bool velocity_at(const std::vector<double>& positions, const Recording& recording, int k, int id,
+                 std::vector<double>& out) {
   const int n = recording.particle_count;
   const int dim = recording.dimension;
   const int first = std::max(0, k - kVelocityHalfWindow);
@@ -241,7 +245,8 @@ Location locate_mismatch(const ResidualField& field, const std::vector<double>& 
     const double ms = rms[i] * rms[i];
     excess[i] = std::max(0.0, ms - noise_ms) * samples[i];
     total_excess += excess[i];
-    if (clearly_above(ms, samples[i], dim, noise, options.min_ratio, options.z)) candidates.push_back(static_cast<int>(i));
+    if (clearly_above(ms, samples[i], dim, noise, options.min_ratio, options.z))
+      candidates.push_back(static_cast<int>(i));
   }
   if (candidates.empty()) return location;
   std::stable_sort(candidates.begin(), candidates.end(), [&](int a, int b) {
@@ -581,8 +586,9 @@ double load_sign_change(const Recording& recording, const ResidualField& field, 
   }
   const double noise = floored_noise(noise_std, object_size(recording));
   if (peak_frame < 0 || !(peak > kSignificance * noise * std::sqrt(dim))) return 0.0;
-  std::vector<double> direction(load.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(peak_frame) * udim),
-                                load.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(peak_frame + 1) * udim));
+  std::vector<double> direction(
+      load.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(peak_frame) * udim),
+      load.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(peak_frame + 1) * udim));
   for (double& c : direction) c /= peak;
 
   double sum_small = 0;
@@ -618,7 +624,8 @@ double load_sign_change(const Recording& recording, const ResidualField& field, 
 double time_shift(const Recording& recording, const std::vector<double>& simulated, const Location& location,
                   double noise_std) {
   check_recording(recording);
-  if (simulated.size() != recording.positions.size()) throw std::invalid_argument("time_shift: simulated size differs from positions");
+  if (simulated.size() != recording.positions.size())
+    throw std::invalid_argument("time_shift: simulated size differs from positions");
   const int n = recording.particle_count;
   const int dim = recording.dimension;
   const int frames = recording.frame_count();
@@ -639,7 +646,8 @@ double time_shift(const Recording& recording, const std::vector<double>& simulat
     for (int k = 0; k < frames; ++k) {
       for (std::size_t j = 0; j < ids.size(); ++j) {
         if (!velocity_at(positions, recording, k, ids[j], one)) continue;
-        std::copy(one.begin(), one.end(), v.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(k) * per_frame + j * udim));
+        std::copy(one.begin(), one.end(),
+                  v.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(k) * per_frame + j * udim));
       }
     }
     return v;
@@ -673,12 +681,14 @@ double time_shift(const Recording& recording, const std::vector<double>& simulat
     samples[slot] = count;
     products[slot] = dot;
   }
-  const auto best = static_cast<std::size_t>(std::max_element(correlation.begin(), correlation.end()) - correlation.begin());
+  const auto best =
+      static_cast<std::size_t>(std::max_element(correlation.begin(), correlation.end()) - correlation.begin());
   const double peak = correlation[best];
   if (!(peak > 0) || !(peak * std::sqrt(samples[best]) > kSignificance)) return 0.0;
   std::vector<double> steps;
   for (int k = 0; k + 1 < frames; ++k) {
-    steps.push_back(recording.frame_times_s[static_cast<std::size_t>(k + 1)] - recording.frame_times_s[static_cast<std::size_t>(k)]);
+    steps.push_back(recording.frame_times_s[static_cast<std::size_t>(k + 1)] -
+                    recording.frame_times_s[static_cast<std::size_t>(k)]);
   }
   std::nth_element(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(steps.size() / 2), steps.end());
   const double step = steps[steps.size() / 2];
@@ -742,7 +752,8 @@ std::map<std::string, double> residual_signatures(const Recording& recording, co
 std::map<std::string, double> residual_signatures(const Recording& recording, const std::vector<double>& simulated,
                                                   double noise_std) {
   check_recording(recording);
-  const ResidualField field = make_residual_field(recording.positions, simulated, recording.particle_count, recording.dimension);
+  const ResidualField field =
+      make_residual_field(recording.positions, simulated, recording.particle_count, recording.dimension);
   const Location location = locate_mismatch(field, recording.frame_times_s, noise_std);
   return residual_signatures(recording, simulated, field, location, noise_std);
 }

@@ -141,7 +141,8 @@ struct SimulatorImpl {
     for (int k = 1; k < frames; ++k) {
       gather(k);
       MsmStepInput<Dim, double> input;
-      input.dt = recording.frame_times_s[static_cast<std::size_t>(k)] - recording.frame_times_s[static_cast<std::size_t>(k - 1)];
+      input.dt = recording.frame_times_s[static_cast<std::size_t>(k)] -
+                 recording.frame_times_s[static_cast<std::size_t>(k - 1)];
       input.driven = {ids.data(), targets.data(), static_cast<int>(ids.size())};
       const Status status = msm_step(m, params, input, state);
       if (status == Status::invalid_argument || status == Status::not_initialized) {
@@ -179,12 +180,16 @@ std::vector<double> RecordingSimulator::simulate(const ModelSettings& settings) 
   if (settings.support_friction >= 0) {
     double length = 0;
     for (double v : support_normal_) length += v * v;
-    if (!(length > 0.5)) throw std::runtime_error("support friction needs fixed particles spanning a support line or plane");
+    if (!(length > 0.5))
+      throw std::runtime_error("support friction needs fixed particles spanning a support line or plane");
   }
-  return impl2_ ? impl2_->run(recording_, support_normal_, settings) : impl3_->run(recording_, support_normal_, settings);
+  return impl2_ ? impl2_->run(recording_, support_normal_, settings)
+                : impl3_->run(recording_, support_normal_, settings);
 }
 
-const std::vector<double>& RecordingSimulator::rest() const { return impl2_ ? impl2_->model->rest : impl3_->model->rest; }
+const std::vector<double>& RecordingSimulator::rest() const {
+  return impl2_ ? impl2_->model->rest : impl3_->model->rest;
+}
 
 int RecordingSimulator::cluster_count() const {
   return impl2_ ? impl2_->model->model.cluster_count : impl3_->model->model.cluster_count;
@@ -196,9 +201,12 @@ std::vector<unsigned char> compared_pairs(const Recording& recording) {
   std::vector<unsigned char> mask(static_cast<std::size_t>(frames) * static_cast<std::size_t>(n), 0);
   for (int k = 0; k < frames; ++k) {
     const double t = recording.frame_times_s[static_cast<std::size_t>(k)];
-    for (int i = 0; i < n; ++i) mask[static_cast<std::size_t>(k) * static_cast<std::size_t>(n) + static_cast<std::size_t>(i)] = recording.observed(k, i) ? 1 : 0;
+    for (int i = 0; i < n; ++i)
+      mask[static_cast<std::size_t>(k) * static_cast<std::size_t>(n) + static_cast<std::size_t>(i)] =
+          recording.observed(k, i) ? 1 : 0;
     for (const DrivenWindow& window : recording.driven) {
-      if (window.active_at(t)) mask[static_cast<std::size_t>(k) * static_cast<std::size_t>(n) + static_cast<std::size_t>(window.id)] = 0;
+      if (window.active_at(t))
+        mask[static_cast<std::size_t>(k) * static_cast<std::size_t>(n) + static_cast<std::size_t>(window.id)] = 0;
     }
   }
   return mask;

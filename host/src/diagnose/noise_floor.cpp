@@ -20,8 +20,7 @@ using Vector4 = Eigen::Matrix<double, kMaxDegree + 1, 1>;
 
 // Residual of sample `center` against the local polynomial through (t, y), divided by its
 // exact noise gain sqrt(1 - H_cc). Returns false when the window cannot give one.
-bool normalised_residual(const std::vector<double>& t, const std::vector<double>& y, std::size_t center,
-                         double& out) {
+bool normalised_residual(const std::vector<double>& t, const std::vector<double>& y, std::size_t center, double& out) {
   const int samples = static_cast<int>(t.size());
   const int degree = std::min(kMaxDegree, samples - 2);
   if (degree < 1) return false;

@@ -62,8 +62,10 @@ double ResidualField::squared_norm(int frame, int id) const {
 
 ResidualField make_residual_field(const std::vector<double>& observed, const std::vector<double>& simulated,
                                   int particle_count, int dimension) {
-  if (dimension < 1 || particle_count < 0) throw std::invalid_argument("residual field: bad dimension or particle count");
-  if (observed.size() != simulated.size()) throw std::invalid_argument("residual field: observed and simulated differ in size");
+  if (dimension < 1 || particle_count < 0)
+    throw std::invalid_argument("residual field: bad dimension or particle count");
+  if (observed.size() != simulated.size())
+    throw std::invalid_argument("residual field: observed and simulated differ in size");
   ResidualField field;
   field.particle_count = particle_count;
   field.dimension = dimension;
@@ -72,7 +74,8 @@ ResidualField make_residual_field(const std::vector<double>& observed, const std
     return field;
   }
   const std::size_t pair = static_cast<std::size_t>(particle_count) * static_cast<std::size_t>(dimension);
-  if (observed.size() % pair != 0) throw std::invalid_argument("residual field: size is not a multiple of particle_count * dimension");
+  if (observed.size() % pair != 0)
+    throw std::invalid_argument("residual field: size is not a multiple of particle_count * dimension");
   field.frame_count = static_cast<int>(observed.size() / pair);
   field.residual.assign(observed.size(), std::numeric_limits<double>::quiet_NaN());
   const auto dim = static_cast<std::size_t>(dimension);
@@ -127,8 +130,8 @@ std::vector<double> residual_magnitudes(const ResidualField& field) {
     for (int i = 0; i < field.particle_count; ++i) {
       const double squared = field.squared_norm(k, i);
       if (std::isfinite(squared)) {
-        out[static_cast<std::size_t>(k) * static_cast<std::size_t>(field.particle_count) + static_cast<std::size_t>(i)] =
-            std::sqrt(squared);
+        out[static_cast<std::size_t>(k) * static_cast<std::size_t>(field.particle_count) +
+            static_cast<std::size_t>(i)] = std::sqrt(squared);
       }
     }
   }

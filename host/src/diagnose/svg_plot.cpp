@@ -39,21 +39,11 @@ std::string escape(std::string_view text) {
   out.reserve(text.size() + text.size() / 8);
   for (const char c : text) {
     switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      case '\'':
-        out += "&#39;";
-        break;
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&#39;"; break;
       default: {
         const auto byte = static_cast<unsigned char>(c);
         const bool control = (byte < 0x20 && c != '\t' && c != '\n') || byte == 0x7f;
@@ -137,23 +127,20 @@ double Area::py(double y) const {
   return top + (y_max - y) / (y_max - y_min) * height;
 }
 
-void open(std::string& out, std::string_view name, std::string_view title, double width,
-          double height) {
+void open(std::string& out, std::string_view name, std::string_view title, double width, double height) {
   out += "<svg xmlns=\"http://www.w3.org/2000/svg\" class=\"plot\" data-plot=\"";
   out += escape(name);
-  out += "\" width=\"" + coord(width) + "\" height=\"" + coord(height) + "\" viewBox=\"0 0 " +
-         coord(width) + " " + coord(height) + "\" role=\"img\" " + kFont + ">\n<title>";
+  out += "\" width=\"" + coord(width) + "\" height=\"" + coord(height) + "\" viewBox=\"0 0 " + coord(width) + " " +
+         coord(height) + "\" role=\"img\" " + kFont + ">\n<title>";
   out += escape(title);
   out += "</title>\n";
   // A white background keeps the plot readable when copied out of the page.
-  out += "<rect x=\"0\" y=\"0\" width=\"" + coord(width) + "\" height=\"" + coord(height) +
-         "\" fill=\"#ffffff\"/>\n";
+  out += "<rect x=\"0\" y=\"0\" width=\"" + coord(width) + "\" height=\"" + coord(height) + "\" fill=\"#ffffff\"/>\n";
 }
 
 void close(std::string& out) { out += "</svg>\n"; }
 
-void text(std::string& out, double x, double y, std::string_view content,
-          std::string_view attributes) {
+void text(std::string& out, double x, double y, std::string_view content, std::string_view attributes) {
   out += "<text x=\"" + coord(x) + "\" y=\"" + coord(y) + "\"";
   if (!attributes.empty()) {
     out += ' ';
@@ -164,13 +151,12 @@ void text(std::string& out, double x, double y, std::string_view content,
   out += "</text>\n";
 }
 
-void axes(std::string& out, const Area& area, const Ticks& x_ticks, const Ticks& y_ticks,
-          std::string_view x_label, std::string_view y_label) {
+void axes(std::string& out, const Area& area, const Ticks& x_ticks, const Ticks& y_ticks, std::string_view x_label,
+          std::string_view y_label) {
   const double bottom = area.top + area.height;
   const double right = area.left + area.width;
-  out += "<rect x=\"" + coord(area.left) + "\" y=\"" + coord(area.top) + "\" width=\"" +
-         coord(area.width) + "\" height=\"" + coord(area.height) + "\" fill=\"none\" stroke=\"" +
-         kAxisColour + "\" stroke-width=\"1\"/>\n";
+  out += "<rect x=\"" + coord(area.left) + "\" y=\"" + coord(area.top) + "\" width=\"" + coord(area.width) +
+         "\" height=\"" + coord(area.height) + "\" fill=\"none\" stroke=\"" + kAxisColour + "\" stroke-width=\"1\"/>\n";
   const double x_lo = std::min(area.x_min, area.x_max);
   const double x_hi = std::max(area.x_min, area.x_max);
   const double y_lo = std::min(area.y_min, area.y_max);
@@ -198,12 +184,11 @@ void axes(std::string& out, const Area& area, const Ticks& x_ticks, const Ticks&
   text(out, (area.left + right) / 2, bottom + 32, x_label, "text-anchor=\"middle\"");
   const double yx = area.left - 44;
   const double yy = area.top + area.height / 2;
-  text(out, yx, yy, y_label,
-       "text-anchor=\"middle\" transform=\"rotate(-90 " + coord(yx) + " " + coord(yy) + ")\"");
+  text(out, yx, yy, y_label, "text-anchor=\"middle\" transform=\"rotate(-90 " + coord(yx) + " " + coord(yy) + ")\"");
 }
 
-void polyline(std::string& out, const Area& area, const std::vector<double>& xs,
-              const std::vector<double>& ys, std::string_view attributes) {
+void polyline(std::string& out, const Area& area, const std::vector<double>& xs, const std::vector<double>& ys,
+              std::string_view attributes) {
   const std::size_t n = std::min(xs.size(), ys.size());
   std::string points;
   std::size_t count = 0;
@@ -231,16 +216,16 @@ void polyline(std::string& out, const Area& area, const std::vector<double>& xs,
   flush();
 }
 
-void colour_bar(std::string& out, double left, double top, double width, double height,
-                double v_min, double v_max, int levels, std::string_view label, bool clamped_top) {
+void colour_bar(std::string& out, double left, double top, double width, double height, double v_min, double v_max,
+                int levels, std::string_view label, bool clamped_top) {
   levels = std::max(levels, 1);
   const double band = height / static_cast<double>(levels);
   for (int i = 0; i < levels; ++i) {
     const double t = (static_cast<double>(i) + 0.5) / static_cast<double>(levels);
     // Band 0 (lowest values) sits at the bottom. Bands overlap by a hair to avoid seams.
     const double y = top + height - static_cast<double>(i + 1) * band;
-    out += "<rect x=\"" + coord(left) + "\" y=\"" + coord(y) + "\" width=\"" + coord(width) +
-           "\" height=\"" + coord(band + 0.5) + "\" fill=\"" + colour(t) + "\"/>\n";
+    out += "<rect x=\"" + coord(left) + "\" y=\"" + coord(y) + "\" width=\"" + coord(width) + "\" height=\"" +
+           coord(band + 0.5) + "\" fill=\"" + colour(t) + "\"/>\n";
   }
   Area area;
   area.left = left;
@@ -249,8 +234,8 @@ void colour_bar(std::string& out, double left, double top, double width, double 
   area.height = height;
   area.y_min = v_min;
   area.y_max = v_max;
-  out += "<rect x=\"" + coord(left) + "\" y=\"" + coord(top) + "\" width=\"" + coord(width) +
-         "\" height=\"" + coord(height) + "\" fill=\"none\" stroke=\"" + kAxisColour + "\"/>\n";
+  out += "<rect x=\"" + coord(left) + "\" y=\"" + coord(top) + "\" width=\"" + coord(width) + "\" height=\"" +
+         coord(height) + "\" fill=\"none\" stroke=\"" + kAxisColour + "\"/>\n";
   const Ticks ticks = linear_ticks(v_min, v_max, 5);
   std::string marks;
   for (std::size_t i = 0; i < ticks.at.size(); ++i) {
@@ -266,8 +251,7 @@ void colour_bar(std::string& out, double left, double top, double width, double 
   }
   const double lx = left + width + 52;
   const double ly = top + height / 2;
-  text(out, lx, ly, label,
-       "text-anchor=\"middle\" transform=\"rotate(-90 " + coord(lx) + " " + coord(ly) + ")\"");
+  text(out, lx, ly, label, "text-anchor=\"middle\" transform=\"rotate(-90 " + coord(lx) + " " + coord(ly) + ")\"");
 }
 
 }  // namespace pliant::host::svg

@@ -46,27 +46,25 @@ struct Area {
 };
 
 /// Opens `<svg class="plot" data-plot="name">` of the given size with a `<title>` and closes it.
-void open(std::string& out, std::string_view name, std::string_view title, double width,
-          double height);
+void open(std::string& out, std::string_view name, std::string_view title, double width, double height);
 void close(std::string& out);
 
 /// Text at (x, y) in pixels; `attributes` is inserted verbatim (e.g. text-anchor="end").
-void text(std::string& out, double x, double y, std::string_view content,
-          std::string_view attributes = "");
+void text(std::string& out, double x, double y, std::string_view content, std::string_view attributes = "");
 
 /// Frame, ticks with labels, and axis titles around `area`. Ticks outside the data range are
 /// dropped.
-void axes(std::string& out, const Area& area, const Ticks& x_ticks, const Ticks& y_ticks,
-          std::string_view x_label, std::string_view y_label);
+void axes(std::string& out, const Area& area, const Ticks& x_ticks, const Ticks& y_ticks, std::string_view x_label,
+          std::string_view y_label);
 
 /// The points (xs[i], ys[i]) joined in order; NaN in either coordinate breaks the line into
 /// separate pieces. `attributes` styles the line (stroke, stroke-width, dasharray...).
-void polyline(std::string& out, const Area& area, const std::vector<double>& xs,
-              const std::vector<double>& ys, std::string_view attributes);
+void polyline(std::string& out, const Area& area, const std::vector<double>& xs, const std::vector<double>& ys,
+              std::string_view attributes);
 
 /// Vertical colour bar for the range [v_min, v_max] drawn with `levels` bands, labelled with
 /// ticks and `label`; `clamped_top` marks the top value as "at least".
-void colour_bar(std::string& out, double left, double top, double width, double height,
-                double v_min, double v_max, int levels, std::string_view label, bool clamped_top);
+void colour_bar(std::string& out, double left, double top, double width, double height, double v_min, double v_max,
+                int levels, std::string_view label, bool clamped_top);
 
 }  // namespace pliant::host::svg

@@ -39,9 +39,9 @@ std::vector<int> minimum_degree_order(const std::vector<std::vector<int>>& graph
 // Symbolic factorization for one ordering: elimination tree (Liu, with path compression),
 // postorder, and the row structure of every block column of L.
 struct Symbolic {
-  std::vector<int> perm;                     // perm[new] = old, postordered
-  std::vector<int> parent;                   // elimination tree, new numbering
-  std::vector<std::vector<int>> structure;   // sorted rows (new numbering), diagonal first
+  std::vector<int> perm;                    // perm[new] = old, postordered
+  std::vector<int> parent;                  // elimination tree, new numbering
+  std::vector<std::vector<int>> structure;  // sorted rows (new numbering), diagonal first
 };
 
 Symbolic symbolic_factorization(const std::vector<std::vector<int>>& graph, const std::vector<int>& order) {
@@ -211,9 +211,9 @@ void BlockCholesky::analyze(int node_count, const std::vector<std::vector<int>>&
         const long long width = current.end - child.first;
         const long long below = static_cast<long long>(current.rows.size()) - (current.end - current.first);
         const long long stored = width * (width + below) - width * (width - 1) / 2;
-        const double zeros =
-            1.0 - static_cast<double>(child.nonzeros + current.nonzeros) / static_cast<double>(stored);
-        const bool accept = width <= 1 || (width <= 4 && zeros <= 0.5) || (width <= 16 && zeros <= 0.1) || zeros <= 0.02;
+        const double zeros = 1.0 - static_cast<double>(child.nonzeros + current.nonzeros) / static_cast<double>(stored);
+        const bool accept =
+            width <= 1 || (width <= 4 && zeros <= 0.5) || (width <= 16 && zeros <= 0.1) || zeros <= 0.02;
         if (!accept) break;
         Group merged;
         merged.first = child.first;
@@ -349,7 +349,8 @@ bool BlockCholesky::factorize() {
       update.noalias() = below.bottomRows(rows) * below.middleRows(3 * target.begin, cols).transpose();
       const int ts = target.supernode;
       const int tfirst = super_first_[uz(ts)];
-      const std::ptrdiff_t tld = 3 * static_cast<std::ptrdiff_t>(super_rows_begin_[uz(ts + 1)] - super_rows_begin_[uz(ts)]);
+      const std::ptrdiff_t tld =
+          3 * static_cast<std::ptrdiff_t>(super_rows_begin_[uz(ts + 1)] - super_rows_begin_[uz(ts)]);
       double* tpanel = values_.data() + super_values_[uz(ts)];
       const int* map = target_rows_.data() + target.map_offset;
       for (int kc = target.begin; kc < target.end; ++kc) {

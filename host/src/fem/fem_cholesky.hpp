@@ -49,18 +49,18 @@ class BlockCholesky {
  private:
   struct Target {  // one ancestor supernode receiving part of a supernode's update
     int supernode = 0;
-    int begin = 0;      // first below-row (index into the source's below rows) in its columns
-    int end = 0;        // one past the last
-    int map_offset = 0; // into target_rows_: positions in the target's rows for below-rows begin..
+    int begin = 0;       // first below-row (index into the source's below rows) in its columns
+    int end = 0;         // one past the last
+    int map_offset = 0;  // into target_rows_: positions in the target's rows for below-rows begin..
   };
 
   int node_count_ = 0;
-  std::vector<int> perm_;      // perm_[new] = old
-  std::vector<int> inverse_;   // inverse_[old] = new
+  std::vector<int> perm_;     // perm_[new] = old
+  std::vector<int> inverse_;  // inverse_[old] = new
   std::vector<int> node_super_;
-  std::vector<int> super_first_;      // first node (new numbering) of each supernode, plus end
-  std::vector<int> super_rows_begin_; // into rows_, per supernode plus end
-  std::vector<int> rows_;             // row nodes (new numbering) of each supernode, sorted
+  std::vector<int> super_first_;              // first node (new numbering) of each supernode, plus end
+  std::vector<int> super_rows_begin_;         // into rows_, per supernode plus end
+  std::vector<int> rows_;                     // row nodes (new numbering) of each supernode, sorted
   std::vector<std::ptrdiff_t> super_values_;  // offset of each panel in values_
   std::vector<int> super_targets_begin_;
   std::vector<Target> targets_;

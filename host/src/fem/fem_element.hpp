@@ -57,8 +57,8 @@ inline void add_rotated_stiffness_product(const Mat34& c, double volume, double 
 /// Block (a, b) of R K_e R^T: V (lambda c_a c_b^T + mu c_b c_a^T + mu (b_a . b_b) I).
 inline Eigen::Matrix3d rotated_stiffness_block(const Mat34& c, const Mat34& b, int ia, int ib, double volume, double mu,
                                                double lambda) {
-  Eigen::Matrix3d k = (volume * lambda) * c.col(ia) * c.col(ib).transpose() +
-                      (volume * mu) * c.col(ib) * c.col(ia).transpose();
+  Eigen::Matrix3d k =
+      (volume * lambda) * c.col(ia) * c.col(ib).transpose() + (volume * mu) * c.col(ib) * c.col(ia).transpose();
   k.diagonal().array() += volume * mu * b.col(ia).dot(b.col(ib));
   return k;
 }

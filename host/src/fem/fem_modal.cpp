@@ -74,7 +74,8 @@ class ShiftSolve {
       for (int d = 0; d < 3; ++d) values[slot.offset + d * (slot.row_stride + slot.col_stride)] -= sigma;
     }
     if (!cholesky_.factorize()) {
-      throw std::runtime_error("modal_analysis: shifted stiffness is not positive definite (shift above the lowest mode?)");
+      throw std::runtime_error(
+          "modal_analysis: shifted stiffness is not positive definite (shift above the lowest mode?)");
     }
   }
   void perform_op(const double* x_in, double* y_out) const {
@@ -124,7 +125,8 @@ FemModes modal_analysis(const FemModel& model, const std::vector<int>& fixed_nod
       const auto& b = model.shape_gradients(e);
       const double scale = model.youngs_modulus_pa()[e] * model.element_volume_m3()[e] *
                            (model.unit_lambda() + 4.0 * model.unit_mu());  // trace of each diagonal block / |b|^2
-      for (int a = 0; a < 4; ++a) trace += scale * b.col(a).squaredNorm() / model.lumped_mass_kg()[model.elements()[uz(e)][uz(a)]];
+      for (int a = 0; a < 4; ++a)
+        trace += scale * b.col(a).squaredNorm() / model.lumped_mass_kg()[model.elements()[uz(e)][uz(a)]];
     }
     shift = -1e-10 * trace / static_cast<double>(model.dof_count());
   }

@@ -127,7 +127,8 @@ Eigen::Matrix<double, 12, 12> FemModel::unit_element_stiffness(int element) cons
   Eigen::Matrix<double, 12, 12> k;
   for (int a = 0; a < 4; ++a) {
     for (int c = 0; c < 4; ++c) {
-      k.block<3, 3>(3 * a, 3 * c) = detail::rotated_stiffness_block(b, b, a, c, volume_[element], unit_mu_, unit_lambda_);
+      k.block<3, 3>(3 * a, 3 * c) =
+          detail::rotated_stiffness_block(b, b, a, c, volume_[element], unit_mu_, unit_lambda_);
     }
   }
   return k;
@@ -239,8 +240,8 @@ void internal_force(const FemModel& model, const Eigen::Ref<const Eigen::VectorX
     const auto& b = model.shape_gradients(e);
     const Eigen::Matrix3d f = detail::gather_gradient(position_m.data(), nodes, b);
     const double youngs = model.youngs_modulus_pa()[e];
-    const Eigen::Matrix3d p = detail::corotated_stress(f, polar_rotation(f), youngs * model.unit_mu(),
-                                                       youngs * model.unit_lambda(), nullptr);
+    const Eigen::Matrix3d p =
+        detail::corotated_stress(f, polar_rotation(f), youngs * model.unit_mu(), youngs * model.unit_lambda(), nullptr);
     const detail::Mat34 corner = (-model.element_volume_m3()[e]) * (p * b);
     for (int a = 0; a < 4; ++a) force_n.segment<3>(3 * nodes[uz(a)]) += corner.col(a);
   }
@@ -291,8 +292,8 @@ Eigen::SparseMatrix<double> stiffness_matrix(const FemModel& model,
     const double youngs = model.youngs_modulus_pa()[e];
     for (int a = 0; a < 4; ++a) {
       for (int q = 0; q < 4; ++q) {
-        const Eigen::Matrix3d k = detail::rotated_stiffness_block(c, b, a, q, model.element_volume_m3()[e],
-                                                                  youngs * model.unit_mu(), youngs * model.unit_lambda());
+        const Eigen::Matrix3d k = detail::rotated_stiffness_block(
+            c, b, a, q, model.element_volume_m3()[e], youngs * model.unit_mu(), youngs * model.unit_lambda());
         for (int i = 0; i < 3; ++i) {
           for (int j = 0; j < 3; ++j) triplets.emplace_back(3 * nodes[uz(a)] + i, 3 * nodes[uz(q)] + j, k(i, j));
         }

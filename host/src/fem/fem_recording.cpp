@@ -54,8 +54,7 @@ bool position_at(const Recording& recording, int node, int frame, Eigen::Vector3
 }
 
 // Linear interpolation of the wrench at t; false outside the samples' span.
-bool wrench_at(const std::vector<WrenchSample>& samples, double t, Eigen::Vector3d& force,
-               Eigen::Vector3d& torque) {
+bool wrench_at(const std::vector<WrenchSample>& samples, double t, Eigen::Vector3d& force, Eigen::Vector3d& torque) {
   if (samples.empty() || t < samples.front().t_s || t > samples.back().t_s) return false;
   const auto upper = std::lower_bound(samples.begin(), samples.end(), t,
                                       [](const WrenchSample& s, double time) { return s.t_s < time; });
@@ -76,8 +75,7 @@ bool FemRecordingProblem::is_known(const std::string& parameter) const {
   return std::find(known_parameters.begin(), known_parameters.end(), parameter) != known_parameters.end();
 }
 
-FemRecordingProblem fem_problem_from_recording(const Recording& recording,
-                                               const FemRecordingDefaults& defaults) {
+FemRecordingProblem fem_problem_from_recording(const Recording& recording, const FemRecordingDefaults& defaults) {
   const std::string label = "recording " + recording.name + ": ";
   if (recording.dimension != 3) throw std::invalid_argument(label + "the FEM needs a 3D recording");
   if (recording.length_unit != "m") {
@@ -104,8 +102,7 @@ FemRecordingProblem fem_problem_from_recording(const Recording& recording,
   }
   if (recording.gravity && recording.gravity->size() == 3) {
     problem.gravity_declared = true;
-    material.gravity_m_s2 = Eigen::Vector3d((*recording.gravity)[0], (*recording.gravity)[1],
-                                            (*recording.gravity)[2]);
+    material.gravity_m_s2 = Eigen::Vector3d((*recording.gravity)[0], (*recording.gravity)[1], (*recording.gravity)[2]);
   }
 
   problem.fixed_nodes = recording.fixed;
@@ -144,8 +141,8 @@ FemRecordingProblem fem_problem_from_recording(const Recording& recording,
       }
       frame.driven_position_m.segment<3>(3 * static_cast<Eigen::Index>(k)) = p;
     }
-    frame.has_wrench = problem.has_wrench() &&
-                       wrench_at(recording.wrench, frame.time_s, frame.wrench_force_n, frame.wrench_torque_nm);
+    frame.has_wrench =
+        problem.has_wrench() && wrench_at(recording.wrench, frame.time_s, frame.wrench_force_n, frame.wrench_torque_nm);
   }
   return problem;
 }

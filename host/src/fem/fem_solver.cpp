@@ -34,7 +34,8 @@ struct PairSlot {
 void check_node_list(const std::vector<int>& nodes, int node_count, const char* what, std::vector<char>& seen) {
   for (int node : nodes) {
     if (node < 0 || node >= node_count) {
-      throw std::invalid_argument(std::string("FemSolver: ") + what + " node " + std::to_string(node) + " out of range");
+      throw std::invalid_argument(std::string("FemSolver: ") + what + " node " + std::to_string(node) +
+                                  " out of range");
     }
     if (seen[uz(node)] != 0) {
       throw std::invalid_argument(std::string("FemSolver: ") + what + " node " + std::to_string(node) +
@@ -48,22 +49,22 @@ void check_node_list(const std::vector<int>& nodes, int node_count, const char* 
 
 struct FemSolver::Impl {
   const FemModel& model;
-  std::vector<int> free_index;      // node -> free index or -1
-  std::vector<int> free_nodes;      // free index -> node
-  std::vector<int> constrained;     // fixed then driven
+  std::vector<int> free_index;   // node -> free index or -1
+  std::vector<int> free_nodes;   // free index -> node
+  std::vector<int> constrained;  // fixed then driven
   std::vector<int> boundary_elements;
-  std::vector<PairSlot> pair_slots; // 10 per element
+  std::vector<PairSlot> pair_slots;         // 10 per element
   std::vector<std::int64_t> diagonal_slot;  // per free node
   std::vector<std::int32_t> diagonal_ld;
   detail::BlockCholesky cholesky;
   double length_scale = 1;
 
   // Workspaces (3n unless noted).
-  Eigen::VectorXd start;            // positions at the start of the substep
+  Eigen::VectorXd start;  // positions at the start of the substep
   Eigen::VectorXd x;
   Eigen::VectorXd residual;
   Eigen::VectorXd w;
-  Eigen::VectorXd rhs;              // 3 * free nodes
+  Eigen::VectorXd rhs;  // 3 * free nodes
   Eigen::VectorXd reaction;
   Eigen::VectorXd scratch;
   Eigen::VectorXd target;           // 3 * driven nodes
@@ -194,7 +195,9 @@ struct FemSolver::Impl {
 };
 
 FemSolver::FemSolver(const FemModel& model, std::vector<int> fixed_nodes, std::vector<int> driven_nodes)
-    : model_(&model), fixed_(std::move(fixed_nodes)), driven_(std::move(driven_nodes)),
+    : model_(&model),
+      fixed_(std::move(fixed_nodes)),
+      driven_(std::move(driven_nodes)),
       impl_(std::make_unique<Impl>(model)) {
   const int n = model.node_count();
   std::vector<char> seen(uz(n), 0);
@@ -381,9 +384,9 @@ FemStepReport FemSolver::step(FemState& state, double dt_s, const Eigen::Ref<con
       for (int node : im.free_nodes) {
         const Eigen::Index i = 3 * node;
         const double mass = model.lumped_mass_kg()[node];
-        Eigen::Vector3d r = mass * ((im.x.segment<3>(i) - im.start.segment<3>(i)) - h * state.velocity_m_s.segment<3>(i) -
-                                    c_a * state.acceleration_m_s2.segment<3>(i) + alpha * im.w.segment<3>(i) -
-                                    c_f * gravity);
+        Eigen::Vector3d r =
+            mass * ((im.x.segment<3>(i) - im.start.segment<3>(i)) - h * state.velocity_m_s.segment<3>(i) -
+                    c_a * state.acceleration_m_s2.segment<3>(i) + alpha * im.w.segment<3>(i) - c_f * gravity);
         if (has_force) r -= c_f * nodal_force_n.segment<3>(i);
         im.residual.segment<3>(i) += r;
       }
@@ -435,8 +438,8 @@ FemStepReport FemSolver::step(FemState& state, double dt_s, const Eigen::Ref<con
   for (int node : im.constrained) {
     const Eigen::Index i = 3 * node;
     const double mass = model.lumped_mass_kg()[node];
-    Eigen::Vector3d r = im.scratch.segment<3>(i) +
-                        mass * (state.acceleration_m_s2.segment<3>(i) + alpha * state.velocity_m_s.segment<3>(i) - gravity);
+    Eigen::Vector3d r = im.scratch.segment<3>(i) + mass * (state.acceleration_m_s2.segment<3>(i) +
+                                                           alpha * state.velocity_m_s.segment<3>(i) - gravity);
     if (has_force) r -= nodal_force_n.segment<3>(i);
     im.reaction.segment<3>(i) = r;
   }
@@ -510,7 +513,8 @@ FemStaticResult FemSolver::solve_static(const Eigen::Ref<const Eigen::VectorXd>&
         trial.segment<3>(3 * im.free_nodes[k]) += t * im.rhs.segment<3>(3 * static_cast<Eigen::Index>(k));
       }
       trial_energy = potential(trial);
-      if (trial_energy <= energy + 1e-4 * t * slope || std::abs(trial_energy - energy) <= 1e-14 * std::abs(energy)) break;
+      if (trial_energy <= energy + 1e-4 * t * slope || std::abs(trial_energy - energy) <= 1e-14 * std::abs(energy))
+        break;
       t *= 0.5;
     }
     im.x = trial;
@@ -586,7 +590,8 @@ void add_spread_wrench(const Eigen::Vector3d& force_n, const Eigen::Vector3d& to
 Eigen::Vector3d net_force(const Eigen::Ref<const Eigen::VectorXd>& nodal_n, const std::vector<int>& nodes) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   for (int node : nodes) {
-    if (node < 0 || 3 * static_cast<Eigen::Index>(node) >= nodal_n.size()) throw std::invalid_argument("net_force: node out of range");
+    if (node < 0 || 3 * static_cast<Eigen::Index>(node) >= nodal_n.size())
+      throw std::invalid_argument("net_force: node out of range");
     sum += nodal_n.segment<3>(3 * node);
   }
   return sum;
@@ -597,7 +602,8 @@ Eigen::Vector3d net_torque(const Eigen::Ref<const Eigen::VectorXd>& nodal_n, con
   if (nodal_n.size() != position_m.size()) throw std::invalid_argument("net_torque: size mismatch");
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   for (int node : nodes) {
-    if (node < 0 || 3 * static_cast<Eigen::Index>(node) >= nodal_n.size()) throw std::invalid_argument("net_torque: node out of range");
+    if (node < 0 || 3 * static_cast<Eigen::Index>(node) >= nodal_n.size())
+      throw std::invalid_argument("net_torque: node out of range");
     sum += (position_m.segment<3>(3 * node) - point_m).cross(Eigen::Vector3d(nodal_n.segment<3>(3 * node)));
   }
   return sum;

@@ -177,7 +177,8 @@ std::vector<Eigen::Vector3d> place_control_points(const TetMesh& mesh, int k) {
     for (int e = 0; e < m; ++e) {
       int best = 0;
       for (int i = 1; i < k; ++i) {
-        if ((centroids[uz(e)] - seeds[uz(i)]).squaredNorm() < (centroids[uz(e)] - seeds[uz(best)]).squaredNorm()) best = i;
+        if ((centroids[uz(e)] - seeds[uz(i)]).squaredNorm() < (centroids[uz(e)] - seeds[uz(best)]).squaredNorm())
+          best = i;
       }
       if (label[uz(e)] != best) changed = true;
       label[uz(e)] = best;

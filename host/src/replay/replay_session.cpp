@@ -88,8 +88,8 @@ hal::FaultScript parse_script(const std::string& text) {
   hal::FaultScript script;
   hal::FaultScriptError error;
   if (hal::parse_fault_script(text.data(), text.size(), script, error) != hal::HalStatus::ok) {
-    throw std::invalid_argument("fault script:" + std::to_string(error.line) + ":" + std::to_string(error.column) + ": " +
-                                error.message);
+    throw std::invalid_argument("fault script:" + std::to_string(error.line) + ":" + std::to_string(error.column) +
+                                ": " + error.message);
   }
   for (hal::FaultDevice d : {hal::FaultDevice::color_camera, hal::FaultDevice::depth_camera}) {
     if (script.of(d).size() > 0) {
@@ -211,8 +211,8 @@ ReplaySummary replay_recording(const Recording& recording, const ReplayOptions& 
     }
     const bool all_finished = observer.finished() && (!ft || ft->finished()) && (!gripper || gripper->finished());
     if (all_finished) break;
-    const double next_due = std::min({observer.next_due_s(), ft ? ft->next_due_s() : kInf,
-                                      gripper ? gripper->next_due_s() : kInf});
+    const double next_due =
+        std::min({observer.next_due_s(), ft ? ft->next_due_s() : kInf, gripper ? gripper->next_due_s() : kInf});
     if (clock.manual()) {
       clock.set(std::max(next_due, clock.now_s()));
     } else {

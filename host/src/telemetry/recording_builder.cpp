@@ -120,7 +120,8 @@ Recording RecordingBuilder::recording(const std::string& name, const std::string
   r.meta = nlohmann::json::object({{"source", "pliant telemetry"}});
   r.frame_times_s = frame_times_s_;
   r.positions = positions_;
-  r.rest_positions.assign(positions_.begin(), positions_.begin() + static_cast<std::ptrdiff_t>(particle_count_ * dimension_));
+  r.rest_positions.assign(positions_.begin(),
+                          positions_.begin() + static_cast<std::ptrdiff_t>(particle_count_ * dimension_));
   return r;
 }
 

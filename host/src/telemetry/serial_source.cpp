@@ -112,8 +112,6 @@ ReadResult SerialSource::read(std::uint8_t* buffer, std::size_t capacity, int ti
   throw std::runtime_error(state_->device + ": read failed: " + detail::error_text(errno));
 }
 
-std::string SerialSource::describe() const {
-  return state_->device + " at " + std::to_string(state_->baud) + " baud";
-}
+std::string SerialSource::describe() const { return state_->device + " at " + std::to_string(state_->baud) + " baud"; }
 
 }  // namespace pliant::host::telemetry

@@ -13,15 +13,15 @@ namespace pliant::drivers::libcamera_test {
 
 struct FakeBackendState {
   libcamera_detail::StreamSetup setup;
-  int planes_per_buffer = 1;        ///< 2: NV12/NV21 as two planes
+  int planes_per_buffer = 1;  ///< 2: NV12/NV21 as two planes
   hal::HalStatus open_status = hal::HalStatus::ok;
   std::string open_error;
   hal::HalStatus start_status = hal::HalStatus::ok;
   bool refuse_requeue = false;
   std::vector<std::vector<std::uint8_t>> buffers;  ///< [buffer][plane 0 | plane 1 bytes]
-  std::size_t plane0_bytes = 0;     ///< split point when planes_per_buffer == 2
+  std::size_t plane0_bytes = 0;                    ///< split point when planes_per_buffer == 2
   // Recorded.
-  std::vector<int> queued;          ///< buffers the camera holds (queued, not completed)
+  std::vector<int> queued;  ///< buffers the camera holds (queued, not completed)
   std::atomic<int> requeues{0};
   int starts = 0, stops = 0, opens = 0, closes = 0;
   libcamera_detail::CompletionSink* sink = nullptr;

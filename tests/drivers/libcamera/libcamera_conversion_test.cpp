@@ -60,8 +60,8 @@ TEST(LibcameraConversion, FourccMapping) {
   EXPECT_EQ(raw_format_from_fourcc(fourcc('M', 'J', 'P', 'G')), RawFormat::unsupported);
   EXPECT_EQ(raw_format_from_fourcc(fourcc('B', 'A', '8', '1')), RawFormat::unsupported);  // Bayer
   EXPECT_EQ(raw_format_from_fourcc(0), RawFormat::unsupported);
-  for (const RawFormat f : {RawFormat::rgb888, RawFormat::bgr888, RawFormat::xrgb8888, RawFormat::xbgr8888, RawFormat::yuyv,
-                            RawFormat::uyvy, RawFormat::nv12, RawFormat::nv21, RawFormat::r8}) {
+  for (const RawFormat f : {RawFormat::rgb888, RawFormat::bgr888, RawFormat::xrgb8888, RawFormat::xbgr8888,
+                            RawFormat::yuyv, RawFormat::uyvy, RawFormat::nv12, RawFormat::nv21, RawFormat::r8}) {
     EXPECT_EQ(raw_format_from_fourcc(raw_format_fourcc(f)), f) << raw_format_name(f);
   }
   EXPECT_STREQ(raw_format_name(RawFormat::xbgr8888), "XBGR8888");
@@ -85,9 +85,11 @@ TEST(LibcameraConversion, RgbByteOrders) {
     const RawImage image = packed(c.format, 1, 1, c.bytes, c.bytes.size());
     std::uint8_t out[3] = {};
     ASSERT_EQ(convert_raw(image, PixelFormat::rgb8, out, 3, 3), ConvertStatus::ok);
-    EXPECT_EQ((std::vector<int>{out[0], out[1], out[2]}), (std::vector<int>{200, 100, 50})) << raw_format_name(c.format);
+    EXPECT_EQ((std::vector<int>{out[0], out[1], out[2]}), (std::vector<int>{200, 100, 50}))
+        << raw_format_name(c.format);
     ASSERT_EQ(convert_raw(image, PixelFormat::bgr8, out, 3, 3), ConvertStatus::ok);
-    EXPECT_EQ((std::vector<int>{out[0], out[1], out[2]}), (std::vector<int>{50, 100, 200})) << raw_format_name(c.format);
+    EXPECT_EQ((std::vector<int>{out[0], out[1], out[2]}), (std::vector<int>{50, 100, 200}))
+        << raw_format_name(c.format);
     ASSERT_EQ(convert_raw(image, PixelFormat::mono8, out, 1, 1), ConvertStatus::ok);
     EXPECT_NEAR(out[0], 0.299 * 200 + 0.587 * 100 + 0.114 * 50, 1.0) << raw_format_name(c.format);
   }
@@ -133,8 +135,11 @@ TEST(LibcameraConversion, StandardColourBars) {
     int y, u, v;
     Rgb rgb;
   };
-  const Bar bars[] = {{16, 128, 128, {0, 0, 0}},   {235, 128, 128, {255, 255, 255}}, {81, 90, 240, {255, 0, 0}},
-                      {145, 54, 34, {0, 255, 0}}, {41, 240, 110, {0, 0, 255}}};
+  const Bar bars[] = {{16, 128, 128, {0, 0, 0}},
+                      {235, 128, 128, {255, 255, 255}},
+                      {81, 90, 240, {255, 0, 0}},
+                      {145, 54, 34, {0, 255, 0}},
+                      {41, 240, 110, {0, 0, 255}}};
   for (const Bar& bar : bars) {
     const std::vector<std::uint8_t> bytes = {static_cast<std::uint8_t>(bar.u), static_cast<std::uint8_t>(bar.y),
                                              static_cast<std::uint8_t>(bar.v), static_cast<std::uint8_t>(bar.y)};
@@ -182,12 +187,14 @@ TEST(LibcameraConversion, ChromaSitingOfPackedAndSemiPlanarYuv) {
   }
   const std::size_t out_stride = 16;  // 12 bytes of RGB per row plus padding the converter leaves alone
   std::vector<std::uint8_t> out(out_stride * 2, 0);
-  ASSERT_EQ(convert_raw(packed(RawFormat::yuyv, 4, 2, yuyv, stride), PixelFormat::rgb8, out.data(), out_stride, out.size()),
-            ConvertStatus::ok);
+  ASSERT_EQ(
+      convert_raw(packed(RawFormat::yuyv, 4, 2, yuyv, stride), PixelFormat::rgb8, out.data(), out_stride, out.size()),
+      ConvertStatus::ok);
   expect_pixels(out.data(), out_stride, false, "YUYV");
   EXPECT_EQ(out[12], 0);  // padding untouched
-  ASSERT_EQ(convert_raw(packed(RawFormat::uyvy, 4, 2, uyvy, stride), PixelFormat::rgb8, out.data(), out_stride, out.size()),
-            ConvertStatus::ok);
+  ASSERT_EQ(
+      convert_raw(packed(RawFormat::uyvy, 4, 2, uyvy, stride), PixelFormat::rgb8, out.data(), out_stride, out.size()),
+      ConvertStatus::ok);
   expect_pixels(out.data(), out_stride, false, "UYVY");
 
   // NV12 / NV21: a Y plane (stride 6) and one chroma row for both luma rows.
@@ -220,7 +227,9 @@ TEST(LibcameraConversion, MalformedGeometryIsRefusedBeforeAnyAccess) {
   const std::vector<std::uint8_t> bytes(64, 1);
   std::vector<std::uint8_t> out(64, 0);
   const auto run = [&](RawImage image, PixelFormat format = PixelFormat::rgb8, std::size_t out_stride = 12,
-                       std::size_t out_bytes = 64) { return convert_raw(image, format, out.data(), out_stride, out_bytes); };
+                       std::size_t out_bytes = 64) {
+    return convert_raw(image, format, out.data(), out_stride, out_bytes);
+  };
   RawImage good = packed(RawFormat::yuyv, 4, 2, bytes, 8);
   ASSERT_EQ(run(good), ConvertStatus::ok);
 

@@ -17,7 +17,8 @@ using hal::HalStatus;
 TEST(LibcameraLive, ConfigureWithoutACameraIsAClearError) {
   std::string error;
   const std::vector<std::string> cameras = list_libcamera_cameras(&error);
-  if (!cameras.empty()) GTEST_SKIP() << "libcamera lists " << cameras.size() << " camera(s): the no-camera path is not reachable";
+  if (!cameras.empty())
+    GTEST_SKIP() << "libcamera lists " << cameras.size() << " camera(s): the no-camera path is not reachable";
   hal::ManualClock clock;
   LibcameraCamera camera(clock, LibcameraCameraConfig{});
   EXPECT_EQ(camera.configure(), HalStatus::disconnected);

@@ -160,7 +160,7 @@ TEST_F(LibcameraFake, StopCancelsQueuedRequestsAndRestartContinuesNumbering) {
 
   ASSERT_EQ(cam->start(), HalStatus::ok);
   EXPECT_EQ(cam->read(frame), HalStatus::no_data);  // the frame from before the stop is not delivered
-  deliver(2, 0, 52);  // the camera restarts its numbering
+  deliver(2, 0, 52);                                // the camera restarts its numbering
   ASSERT_EQ(cam->read(frame), HalStatus::ok);
   EXPECT_EQ(frame.header.sequence, 3u);
   EXPECT_EQ(frame.data[0], 52);
@@ -329,7 +329,8 @@ TEST_F(LibcameraFake, ConcurrentCompletionsNeverTearAFrame) {
     ++delivered;
     const std::uint8_t first = frame.data[0];
     ASSERT_EQ(first, static_cast<std::uint8_t>((frame.header.sequence - 1) % 251));
-    for (int i = 1; i < kWidth * kHeight; ++i) ASSERT_EQ(frame.data[i], first) << "torn frame " << frame.header.sequence;
+    for (int i = 1; i < kWidth * kHeight; ++i)
+      ASSERT_EQ(frame.data[i], first) << "torn frame " << frame.header.sequence;
   }
   producer.join();
   const LibcameraCameraStats stats = cam->stats();

@@ -74,7 +74,7 @@ TEST(Robotiq2fCodec, CommandRegisters) {
   c.force = 0x40;
   std::uint16_t regs[3];
   r2f::encode_command(c, regs);
-  EXPECT_EQ(regs[0], 0x0900);  // HARDWARE.md 2.1: move = {0x0900, 0x00PP, SSFF}
+  EXPECT_EQ(regs[0], 0x0900);  // 2F manual: move = {0x0900, 0x00PP, SSFF} (docs/drivers/modbus.md)
   EXPECT_EQ(regs[1], 0x00ff);
   EXPECT_EQ(regs[2], 0x8040);
   r2f::Command activate;
@@ -158,8 +158,8 @@ TEST(Robotiq2fCodec, FaultByteGoesToBits8To15) {
 TEST(Robotiq2fCodec, StatusRoundTripEveryStatusAndFaultByte) {
   for (unsigned b0 = 0; b0 < 256; ++b0) {
     for (unsigned b2 = 0; b2 < 256; b2 += 5) {
-      const std::uint16_t regs[3] = {static_cast<std::uint16_t>(b0 << 8 | 0x5a), static_cast<std::uint16_t>(b2 << 8 | 0x77),
-                                     0x99aa};
+      const std::uint16_t regs[3] = {static_cast<std::uint16_t>(b0 << 8 | 0x5a),
+                                     static_cast<std::uint16_t>(b2 << 8 | 0x77), 0x99aa};
       std::uint16_t again[3];
       r2f::encode_status(r2f::decode_status(regs), again);
       // Bits 1, 2 of byte 0 are not defined in the map and are dropped; everything else survives.
@@ -174,10 +174,10 @@ TEST(Robotiq2fCodec, PositionWidthScaling) {
   r2f::Scaling sc;
   EXPECT_EQ(r2f::width_to_position(0.085, sc), 0);
   EXPECT_EQ(r2f::width_to_position(0.0, sc), 255);
-  EXPECT_EQ(r2f::width_to_position(0.04, sc), 135);     // 255 - 120
-  EXPECT_EQ(r2f::width_to_position(0.2, sc), 0);       // clamped
+  EXPECT_EQ(r2f::width_to_position(0.04, sc), 135);  // 255 - 120
+  EXPECT_EQ(r2f::width_to_position(0.2, sc), 0);     // clamped
   EXPECT_EQ(r2f::width_to_position(-1.0, sc), 255);
-  EXPECT_EQ(r2f::width_to_position(kNaN, sc), 0);      // NaN: open_byte
+  EXPECT_EQ(r2f::width_to_position(kNaN, sc), 0);  // NaN: open_byte
   EXPECT_DOUBLE_EQ(r2f::position_to_width(0, sc), 0.085);
   EXPECT_DOUBLE_EQ(r2f::position_to_width(255, sc), 0.0);
   for (int p = 0; p < 256; ++p) {
@@ -194,7 +194,7 @@ TEST(Robotiq2fCodec, PositionWidthScaling) {
   EXPECT_NEAR(r2f::position_to_width(3, cal), 0.140, 1e-12);
   EXPECT_NEAR(r2f::position_to_width(230, cal), 0.0, 1e-12);
   EXPECT_NEAR(r2f::position_to_width(116, cal), 0.140 * (230.0 - 116.0) / 227.0, 1e-12);
-  EXPECT_DOUBLE_EQ(r2f::position_to_width(0, cal), 0.140);   // beyond the open end: clamped
+  EXPECT_DOUBLE_EQ(r2f::position_to_width(0, cal), 0.140);  // beyond the open end: clamped
   EXPECT_DOUBLE_EQ(r2f::position_to_width(255, cal), 0.0);  // beyond the closed end: clamped
   // A valid but absurd stroke near DBL_MAX (found by the fuzzer): no overflow in the round trip.
   r2f::Scaling huge;

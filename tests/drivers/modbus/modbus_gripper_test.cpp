@@ -123,7 +123,7 @@ TEST_F(RobotiqGripperTest, ActivationTimesOutAndStartsOver) {
   ASSERT_EQ(gripper->configure(), HalStatus::ok);
   ASSERT_EQ(gripper->start(), HalStatus::ok);
   tick(clock, 0.2);
-  (void)read_ok();  // rACT = 1
+  (void)read_ok();   // rACT = 1
   tick(clock, 1.0);  // the emulator never advances: activation never completes
   (void)read_ok();
   EXPECT_EQ(gripper->driver_counters().activation_retries, 1u);
@@ -163,7 +163,7 @@ TEST_F(RobotiqGripperTest, MoveReachesTheTarget) {
   // Last command had rGTO clear: one write {0x0900, rPR, rSP << 8 | rFR}.
   EXPECT_EQ(emulator.counters().command_writes, writes + 1);
   EXPECT_EQ(emulator.holding_register(r2f::kCommandRegister), 0x0900);
-  EXPECT_EQ(emulator.holding_register(r2f::kCommandRegister + 1), 135);  // 0.04 m on a 2F-85
+  EXPECT_EQ(emulator.holding_register(r2f::kCommandRegister + 1), 135);     // 0.04 m on a 2F-85
   EXPECT_EQ(emulator.holding_register(r2f::kCommandRegister + 2), 0xff32);  // speed 255, force 50
   hal::GripperReading r = read_ok();
   EXPECT_NE(r.header.status_bits & hal::kGripperMoving, 0u);
@@ -283,7 +283,7 @@ TEST_F(RobotiqGripperTest, UnansweredPollIsATimeout) {
   hal::GripperReading r;
   r.width_m = -1.0;
   EXPECT_EQ(gripper->read(r), HalStatus::timeout);  // waits the 2 s budget once
-  EXPECT_EQ(r.width_m, -1.0);                      // not written on failure
+  EXPECT_EQ(r.width_m, -1.0);                       // not written on failure
   EXPECT_EQ(gripper->counters().timeouts, 1u);
   EXPECT_EQ(gripper->link_counters().timeouts, 1u);
   EXPECT_EQ(emulator.counters().dropped, 1u);

@@ -226,7 +226,9 @@ TEST(OpenCvFileErrors, MissingCorruptAndDirectoryVideos) {
   EXPECT_EQ(absent.state(), hal::LifecycleState::unconfigured);
 
   config.location = dir / "garbage.avi";
-  opencv_test::write_bytes(config.location, std::string("RIFF\x10\x00\x00\x00" "AVI LIST garbage, not a video", 37));
+  opencv_test::write_bytes(config.location, std::string("RIFF\x10\x00\x00\x00"
+                                                        "AVI LIST garbage, not a video",
+                                                        37));
   OpenCvCamera corrupt(clock, config);
   EXPECT_EQ(corrupt.configure(), HalStatus::io_error);
   EXPECT_NE(corrupt.last_error().find("cannot decode"), std::string::npos) << corrupt.last_error();
@@ -313,7 +315,8 @@ class OpenCvSequence : public ::testing::Test {
 };
 
 TEST_F(OpenCvSequence, PatternInEveryPixelFormatIsExact) {
-  for (int k = 0; k < 4; ++k) opencv_test::write_png(dir_ / ("frame_" + std::string(k < 10 ? "000" : "00") + std::to_string(k) + ".png"), k);
+  for (int k = 0; k < 4; ++k)
+    opencv_test::write_png(dir_ / ("frame_" + std::string(k < 10 ? "000" : "00") + std::to_string(k) + ".png"), k);
   for (const hal::PixelFormat format : {hal::PixelFormat::rgb8, hal::PixelFormat::bgr8, hal::PixelFormat::mono8}) {
     ManualClock clock(2.0);
     OpenCvCamera camera(clock, sequence_config(dir_ / "frame_%04d.png", format));

@@ -59,7 +59,10 @@ class FakeSource final : public opencv_detail::FrameSource {
     }
     int permits = script_->permits.load();
     do {
-      if (permits <= 0) return opencv_detail::SourceStatus::idle;
+      if (permits <= 0) {
+        if (script_->on_idle) script_->on_idle();
+        return opencv_detail::SourceStatus::idle;
+      }
     } while (!script_->permits.compare_exchange_weak(permits, permits - 1));
     const int number = script_->yielded.load();
     image.create(script_->height.load(), script_->width.load(), CV_8UC3);

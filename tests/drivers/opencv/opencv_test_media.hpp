@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -30,16 +31,20 @@ int frame_index_of(const cv::Vec3b& bgr, int count, int tolerance);
 /// A live (or file-like) source driven by the test: each permit yields one frame whose pixels
 /// all equal the frame's running number (mod 256), of size width x height.
 struct FakeScript {
-  std::atomic<int> permits{0};        ///< frames the source may yield
-  std::atomic<int> yielded{0};        ///< frames yielded so far (all sources of the factory)
-  std::atomic<int> calls{0};          ///< next() calls so far
-  std::atomic<int> last_yield_call{0};///< the call that yielded the last frame
-  std::atomic<bool> fail_next{false}; ///< the next call reports disconnected (then the source is dead)
-  std::atomic<bool> throw_next{false};///< the next call throws
-  std::atomic<int> failing_opens{0};  ///< open() fails this many more times
-  std::atomic<int> opens{0};          ///< open() calls
+  std::atomic<int> permits{0};          ///< frames the source may yield
+  std::atomic<int> yielded{0};          ///< frames yielded so far (all sources of the factory)
+  std::atomic<int> calls{0};            ///< next() calls so far
+  std::atomic<int> last_yield_call{0};  ///< the call that yielded the last frame
+  std::atomic<bool> fail_next{false};   ///< the next call reports disconnected (then the source is dead)
+  std::atomic<bool> throw_next{false};  ///< the next call throws
+  std::atomic<int> failing_opens{0};    ///< open() fails this many more times
+  std::atomic<int> opens{0};            ///< open() calls
   std::atomic<int> width{16};
   std::atomic<int> height{8};
+  /// Called by every next() that returns idle, in the thread that calls next(). Set it only
+  /// while next() runs in the test's own thread (configure, stepped reads): it may then drive a
+  /// ManualClock, which must not be touched from the decoder thread.
+  std::function<void()> on_idle;
 };
 
 /// Waits (up to 10 s) until the fake yielded `yielded` frames in all and the decoder came back

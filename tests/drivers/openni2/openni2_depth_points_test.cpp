@@ -221,10 +221,11 @@ TEST(Openni2DepthToPoints, AgreesWithOpenNi2CoordinateConverter) {
   std::vector<double> ours(640 * 480 * 3);
   for (double z_mm : {500.0, 1234.0, 4000.0}) {
     for (int u : us) {
-      for (int v : vs) image[static_cast<std::size_t>(v) * 640 + static_cast<std::size_t>(u)] = static_cast<std::uint16_t>(z_mm);
+      for (int v : vs)
+        image[static_cast<std::size_t>(v) * 640 + static_cast<std::size_t>(u)] = static_cast<std::uint16_t>(z_mm);
     }
-    const PointsResult r = depth_to_points(reinterpret_cast<const std::uint8_t*>(image.data()), image.size() * 2, 640, 480,
-                                           1280, 1e-3, k, ours.data(), 640 * 480);
+    const PointsResult r = depth_to_points(reinterpret_cast<const std::uint8_t*>(image.data()), image.size() * 2, 640,
+                                           480, 1280, 1e-3, k, ours.data(), 640 * 480);
     ASSERT_EQ(r.status, PointsStatus::ok);
     ASSERT_EQ(r.valid_points, 15u);
     for (int u : us) {

@@ -95,8 +95,8 @@ TEST(Openni2OniFile, RefusesEveryTruncation) {
   ASSERT_EQ(list.size(), 151u);
   std::vector<std::size_t> cuts = {0, 3, 23, 24, 25, 51, 52};
   for (const oni::Record& r : list) {
-    cuts.push_back(r.offset);      // at a record boundary: the rest is missing
-    cuts.push_back(r.offset + 13); // inside a header
+    cuts.push_back(r.offset);       // at a record boundary: the rest is missing
+    cuts.push_back(r.offset + 13);  // inside a header
     cuts.push_back(r.offset + r.fields - 1 + (r.payload > 0 ? r.payload / 2 : 0));  // inside fields or payload
   }
   for (std::size_t cut : cuts) {
@@ -160,7 +160,11 @@ TEST(Openni2OniFile, RefusesAimedCorruptions) {
   const std::vector<Case> cases = {
       {"file magic", OniCheck::bad_magic, [](auto& b) { b[1] = 'X'; }},
       {"version 1.0.2.0", OniCheck::unsupported_version, [](auto& b) { b[6] = 2; }},
-      {"version 1.0.0.3", OniCheck::unsupported_version, [](auto& b) { b[6] = 0; oni::put32(b, 8, 3); }},
+      {"version 1.0.0.3", OniCheck::unsupported_version,
+       [](auto& b) {
+         b[6] = 0;
+         oni::put32(b, 8, 3);
+       }},
       {"1000 nodes", OniCheck::bad_node_count, [](auto& b) { oni::put32(b, 20, 999); }},
       {"record magic", OniCheck::bad_record, [&](auto& b) { b[int_prop.offset] = 'M'; }},
       {"record type 1", OniCheck::bad_record, [&](auto& b) { oni::put32(b, int_prop.offset + 4, 1); }},
@@ -175,7 +179,8 @@ TEST(Openni2OniFile, RefusesAimedCorruptions) {
          const std::uint32_t name_len = oni::get32(b, int_prop.offset + 28);
          oni::put32(b, int_prop.offset + 32 + name_len, 4);
        }},
-      {"name length beyond the fields", OniCheck::bad_string, [&](auto& b) { oni::put32(b, int_prop.offset + 28, 500); }},
+      {"name length beyond the fields", OniCheck::bad_string,
+       [&](auto& b) { oni::put32(b, int_prop.offset + 28, 500); }},
       {"empty name", OniCheck::bad_string, [&](auto& b) { oni::put32(b, int_prop.offset + 28, 0); }},
       {"node id above the header's", OniCheck::bad_node, [&](auto& b) { oni::put32(b, int_prop.offset + 8, 7); }},
       {"property of a node not added yet", OniCheck::bad_node, [&](auto& b) { oni::put32(b, int_prop.offset + 8, 3); }},
@@ -199,7 +204,8 @@ TEST(Openni2OniFile, RefusesAimedCorruptions) {
          // Shrink the table by one entry and move the End record up behind it.
          const std::size_t end_of_table = seek_table.offset + seek_table.fields + seek_table.payload;
          oni::put32(b, seek_table.offset + 16, seek_table.payload - 20);
-         b.erase(b.begin() + static_cast<std::ptrdiff_t>(end_of_table - 20), b.begin() + static_cast<std::ptrdiff_t>(end_of_table));
+         b.erase(b.begin() + static_cast<std::ptrdiff_t>(end_of_table - 20),
+                 b.begin() + static_cast<std::ptrdiff_t>(end_of_table));
        }},
       {"new data without payload", OniCheck::bad_record,
        [&](auto& b) {
@@ -245,9 +251,15 @@ TEST(Openni2OniFile, SurvivesRandomDamage) {
 
 // A recording built here: one depth node, two frames, no seek table.
 std::vector<std::uint8_t> tiny_recording(bool wide) {
-  std::vector<std::uint8_t> b = {'N', 'I', '1', '0', 1, 0, static_cast<std::uint8_t>(wide ? 1 : 0), 0, static_cast<std::uint8_t>(wide ? 0 : 9), 0, 0, 0};
-  const auto u32 = [&](std::uint32_t v) { for (int i = 0; i < 4; ++i) b.push_back(static_cast<std::uint8_t>(v >> (8 * i))); };
-  const auto u64 = [&](std::uint64_t v) { for (int i = 0; i < 8; ++i) b.push_back(static_cast<std::uint8_t>(v >> (8 * i))); };
+  std::vector<std::uint8_t> b = {
+      'N', 'I', '1', '0', 1, 0, static_cast<std::uint8_t>(wide ? 1 : 0), 0, static_cast<std::uint8_t>(wide ? 0 : 9),
+      0,   0,   0};
+  const auto u32 = [&](std::uint32_t v) {
+    for (int i = 0; i < 4; ++i) b.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
+  };
+  const auto u64 = [&](std::uint64_t v) {
+    for (int i = 0; i < 8; ++i) b.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
+  };
   u64(66000);  // largest timestamp
   u32(1);      // largest node id
   const auto record = [&](std::uint32_t type, std::uint32_t node, const std::vector<std::uint8_t>& fields,
@@ -258,7 +270,10 @@ std::vector<std::uint8_t> tiny_recording(bool wide) {
     u32(node);
     u32(header + static_cast<std::uint32_t>(fields.size()));
     u32(payload);
-    if (wide) u64(0); else u32(0);
+    if (wide)
+      u64(0);
+    else
+      u32(0);
     b.insert(b.end(), fields.begin(), fields.end());
     b.insert(b.end(), payload, 0x11);
   };

@@ -1,12 +1,16 @@
 // drivers/openni2 Openni2Camera on .oni recordings: the room.oni fixture (12 real Kinect depth
-// frames) stepped and in real time, end of stream, stamps, restarts, lifecycle faults, and
-// truncated, corrupted and missing files.
+// frames) stepped and in real time, end of stream, stamps, restarts, lifecycle faults, stalls
+// timed on the injected clock, and truncated, corrupted and missing files.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
+#include <functional>
+#include <memory>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -32,6 +36,28 @@ Openni2CameraConfig recording_config(const std::string& path, Openni2Playback pl
   config.location = path;
   config.playback = playback;
   return config;
+}
+
+// A copy of room.oni whose last depth frame OpenNI2 cannot decode (payload all 0xFF): the player
+// skips it without reporting the end of the file, so a stepped read after frame 11 stalls.
+std::string write_undecodable_last_frame(const pliant::test_support::TempDir& dir) {
+  OniFileInfo info;
+  const OniCheckResult check = check_oni_file(oni::fixture_path(), info);
+  const OniNodeInfo* depth = check.ok() ? info.first_node_of_type(kOniNodeDepth) : nullptr;
+  if (depth == nullptr) throw std::runtime_error("fixture check failed");
+  const std::uint32_t depth_node = depth->id;
+  std::vector<std::uint8_t> bytes = oni::read_bytes(oni::fixture_path());
+  const oni::Record* last = nullptr;
+  const std::vector<oni::Record> records = oni::records(bytes);
+  for (const oni::Record& r : records) {
+    if (r.type == 0x0A && r.node == depth_node) last = &r;
+  }
+  if (last == nullptr) throw std::runtime_error("no depth frame in the fixture");
+  const auto payload = bytes.begin() + static_cast<std::ptrdiff_t>(last->offset + last->fields);
+  std::fill(payload, payload + static_cast<std::ptrdiff_t>(last->payload), std::uint8_t{0xFF});
+  const std::string path = dir / "last_frame_undecodable.oni";
+  oni::write_bytes(path, bytes);
+  return path;
 }
 
 double median_depth_m(const DepthFrame& frame, double* valid_fraction) {
@@ -243,6 +269,145 @@ TEST(Openni2Recording, RealTimePlaybackReachesTheEnd) {
   EXPECT_EQ(camera.cleanup(), HalStatus::ok);
 }
 
+// A stepped read blocks at most step_timeout_s of real time; whether a read that found nothing
+// ends the stream is the injected clock's decision. The fixture with an undecodable last frame:
+// OpenNI2's player skips it, then reports the end of the file while the read waits, so only the
+// first read after frame 11 is a stall (the next one sees the end of the file).
+class Openni2SteppedStall : public ::testing::Test {
+ protected:
+  // Plays frames 1..11, moving `clock` between reads by more than step_timeout_s (time between
+  // reads is no stall), then makes the stalled read; true when that read ended the stream.
+  bool stalled_read_ends_stream(const pliant::hal::Clock& clock, const std::function<void()>& between_reads) {
+    Openni2CameraConfig config = recording_config(path_);
+    config.step_timeout_s = 0.2;
+    camera_ = std::make_unique<Openni2Camera>(clock, config);
+    EXPECT_EQ(camera_->configure(), HalStatus::ok) << camera_->last_error();
+    EXPECT_EQ(camera_->start(), HalStatus::ok);
+    DepthFrame frame;
+    for (int k = 1; k <= 11; ++k) {
+      EXPECT_EQ(camera_->read(frame), HalStatus::ok) << "frame " << k;
+      between_reads();
+    }
+    const auto began = std::chrono::steady_clock::now();
+    EXPECT_EQ(camera_->read(frame), HalStatus::no_data);
+    real_wait_ = std::chrono::steady_clock::now() - began;
+    return camera_->end_of_stream();
+  }
+
+  pliant::test_support::TempDir dir_{"pliant_oni_"};
+  std::string path_ = write_undecodable_last_frame(dir_);
+  std::unique_ptr<Openni2Camera> camera_;
+  std::chrono::steady_clock::duration real_wait_{};
+};
+
+TEST_F(Openni2SteppedStall, ManualClockStandingStillNeverEndsTheStream) {
+  pliant::hal::ManualClock clock(100);
+  EXPECT_FALSE(stalled_read_ends_stream(clock, [&clock] { ASSERT_EQ(clock.advance(0.5), HalStatus::ok); }))
+      << "step_timeout_s of real time passed, the injected clock did not move";
+  EXPECT_GE(real_wait_, std::chrono::milliseconds(200)) << "the read waited for the player (the real-time cap)";
+  EXPECT_FALSE(camera_->stats().ended_early);
+  // The caller's time goes on; the next read finds the end of the file OpenNI2 reported meanwhile.
+  ASSERT_EQ(clock.advance(0.25), HalStatus::ok);
+  DepthFrame frame;
+  EXPECT_EQ(camera_->read(frame), HalStatus::no_data);
+  EXPECT_TRUE(camera_->end_of_stream());
+  EXPECT_TRUE(camera_->stats().ended_early);
+  EXPECT_EQ(camera_->stats().last_frame_index, 11);
+  EXPECT_EQ(camera_->counters().samples, 11u);
+  EXPECT_EQ(camera_->stop(), HalStatus::ok);
+  EXPECT_EQ(camera_->cleanup(), HalStatus::ok);
+  camera_.reset();  // before the clock it refers to
+}
+
+// A clock that moves by a fixed step each time it is read moves during a blocking read, which a
+// ManualClock cannot (its only thread is blocked): the same 0.2 s real wait ends the stream or
+// not depending on how far the injected clock moved during it.
+class SteppingClock final : public pliant::hal::Clock {
+ public:
+  SteppingClock(double start_s, double step_s) : now_s_(start_s), step_s_(step_s) {}
+  double now_s() const noexcept override {
+    const double t = now_s_;
+    now_s_ += step_s_;
+    return t;
+  }
+
+ private:
+  mutable double now_s_;
+  double step_s_;
+};
+
+TEST_F(Openni2SteppedStall, EndsOnlyWhenTheInjectedClockPassedTheStepTimeoutDuringTheRead) {
+  // The stalled read reads the clock twice, on entry and after its wait.
+  SteppingClock short_steps(100, 0.15);  // 0.15 s during the read: below step_timeout_s
+  EXPECT_FALSE(stalled_read_ends_stream(short_steps, [] {}));
+  EXPECT_GE(real_wait_, std::chrono::milliseconds(200));
+  EXPECT_FALSE(camera_->stats().ended_early);
+  EXPECT_EQ(camera_->stop(), HalStatus::ok);
+  EXPECT_EQ(camera_->cleanup(), HalStatus::ok);
+
+  camera_.reset();
+  SteppingClock long_steps(100, 0.25);  // 0.25 s during the read: past step_timeout_s
+  EXPECT_TRUE(stalled_read_ends_stream(long_steps, [] {}));
+  EXPECT_TRUE(camera_->stats().ended_early);
+  EXPECT_EQ(camera_->stats().last_frame_index, 11);
+  EXPECT_EQ(camera_->stop(), HalStatus::ok);
+  EXPECT_EQ(camera_->cleanup(), HalStatus::ok);
+  camera_.reset();  // before the clocks it refers to
+}
+
+// With a SteadyClock the injected and the real deadline coincide: the read that times out ends it.
+TEST(Openni2Recording, SteppedStallWithASteadyClockEndsInTheReadThatTimesOut) {
+  pliant::test_support::TempDir dir("pliant_oni_");
+  pliant::hal::SteadyClock clock;
+  Openni2CameraConfig config = recording_config(write_undecodable_last_frame(dir));
+  config.step_timeout_s = 0.2;
+  Openni2Camera camera(clock, config);
+  ASSERT_EQ(camera.configure(), HalStatus::ok) << camera.last_error();
+  ASSERT_EQ(camera.start(), HalStatus::ok);
+  DepthFrame frame;
+  for (int k = 1; k <= 11; ++k) ASSERT_EQ(camera.read(frame), HalStatus::ok) << "frame " << k;
+  const double before = clock.now_s();
+  EXPECT_EQ(camera.read(frame), HalStatus::no_data);
+  EXPECT_GE(clock.now_s() - before, 0.2);
+  EXPECT_TRUE(camera.end_of_stream());
+  EXPECT_TRUE(camera.stats().ended_early);
+  EXPECT_EQ(camera.stop(), HalStatus::ok);
+  EXPECT_EQ(camera.cleanup(), HalStatus::ok);
+}
+
+// Real-time playback at 1/50 speed: the first frame comes after about 0.6 s of real time, the
+// second 1.7 s later. The stall ends the stream only when the injected clock passes
+// stall_timeout_s since the last frame, however much real time passes.
+TEST(Openni2Recording, RealTimeStallEndsOnlyWhenTheInjectedClockPassesTheStallTimeout) {
+  pliant::hal::ManualClock clock(50);
+  Openni2CameraConfig config = recording_config(oni::fixture_path(), Openni2Playback::real_time);
+  config.playback_speed = 0.02;
+  config.stall_timeout_s = 20;  // above three frame intervals at this speed (3 x 1.67 s)
+  Openni2Camera camera(clock, config);
+  ASSERT_EQ(camera.configure(), HalStatus::ok) << camera.last_error();
+  ASSERT_EQ(camera.start(), HalStatus::ok);
+  DepthFrame frame;
+  HalStatus status = HalStatus::no_data;
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while ((status = camera.read(frame)) == HalStatus::no_data && std::chrono::steady_clock::now() < give_up) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));  // real time only: the clock stays at 50
+  }
+  ASSERT_EQ(status, HalStatus::ok) << "no first frame within 10 s";
+  EXPECT_EQ(frame.header.sequence, 1u);
+  EXPECT_FALSE(camera.end_of_stream()) << "the silence before it was real time only";
+  // Frame 2 comes about 1.7 s of real time later: these reads find nothing.
+  ASSERT_EQ(clock.advance(19.9), HalStatus::ok);
+  EXPECT_EQ(camera.read(frame), HalStatus::no_data);
+  EXPECT_FALSE(camera.end_of_stream());
+  ASSERT_EQ(clock.advance(0.2), HalStatus::ok);  // 20.1 s since the first frame
+  EXPECT_EQ(camera.read(frame), HalStatus::no_data);
+  EXPECT_TRUE(camera.end_of_stream());
+  EXPECT_TRUE(camera.stats().ended_early);
+  EXPECT_EQ(camera.stats().last_frame_index, 1);
+  EXPECT_EQ(camera.stop(), HalStatus::ok);
+  EXPECT_EQ(camera.cleanup(), HalStatus::ok);
+}
+
 TEST(Openni2Recording, StopAndStartContinueAndReconfigureReplays) {
   pliant::hal::ManualClock clock(10);
   Openni2Camera camera(clock, recording_config(oni::fixture_path()));
@@ -421,11 +586,16 @@ TEST(Openni2Recording, DamagedFramePayloadsPlayWithoutCrashing) {
     DepthFrame frame;
     int delivered = 0;
     for (int k = 0; k < 20 && !camera.end_of_stream(); ++k) {
-      if (camera.read(frame) == HalStatus::ok) ++delivered;
+      if (camera.read(frame) == HalStatus::ok) {
+        ++delivered;
+      } else {
+        ASSERT_EQ(clock.advance(config.step_timeout_s), HalStatus::ok);  // the loop's time goes on
+      }
     }
     EXPECT_TRUE(camera.end_of_stream()) << "trial " << trial;
     const Openni2CameraStats stats = camera.stats();
-    EXPECT_EQ(static_cast<std::uint64_t>(delivered) + stats.rejected, stats.received) << "every frame delivered or counted";
+    EXPECT_EQ(static_cast<std::uint64_t>(delivered) + stats.rejected, stats.received)
+        << "every frame delivered or counted";
     EXPECT_EQ(camera.stop(), HalStatus::ok);
     EXPECT_EQ(camera.cleanup(), HalStatus::ok);
   }

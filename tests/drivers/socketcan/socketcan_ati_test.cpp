@@ -150,7 +150,7 @@ TEST(SocketCanAti, TareAveragesGoodSamplesOnly) {
   ASSERT_EQ(rig.ft->tare(4), HalStatus::ok);
   EXPECT_TRUE(rig.ft->tare_pending());
   rig.emulator->set_status(0x0020);
-  ASSERT_EQ(rig.cycle(w), HalStatus::ok);  // the answer sent before the change: status 0, counts
+  ASSERT_EQ(rig.cycle(w), HalStatus::ok);     // the answer sent before the change: status 0, counts
   ASSERT_EQ(rig.ft->tare(4), HalStatus::ok);  // start over
   // Samples with a status bit do not count toward the tare. (An answer is read one cycle after
   // the emulator sends it, so a change to the emulator shows one cycle later.)
@@ -196,7 +196,7 @@ TEST(SocketCanAti, TareOnStartWithholdsSamplesUntilZeroed) {
   WrenchReading w;
   EXPECT_EQ(rig.cycle(w), HalStatus::no_data);  // tare sample 1 (the first poll went out with setup)
   EXPECT_EQ(rig.cycle(w), HalStatus::no_data);  // tare sample 2
-  ASSERT_EQ(rig.cycle(w), HalStatus::ok);        // tare sample 3 completes it and is delivered
+  ASSERT_EQ(rig.cycle(w), HalStatus::ok);       // tare sample 3 completes it and is delivered
   for (int k = 0; k < 6; ++k) EXPECT_NEAR(w.wrench[k], 0.0, 1e-12) << k;
   EXPECT_EQ(w.header.sequence, 1u);  // withheld samples are not drops
   EXPECT_EQ(rig.ft->counters().dropped, 0u);
@@ -216,7 +216,8 @@ TEST(SocketCanAti, StatusWordTravelsInTheStatusBits) {
   };
   // Watchdog reset and config-invalid are informational; supply-low, bad calibration and
   // temperature-high are faults (kFtFaultMask); the CAN-bus-error bit is "degraded".
-  const Case cases[] = {{0x0001, false}, {0x0100, false}, {0x8020, true}, {0x0040, true}, {0x0800, true}, {0x4000, false}};
+  const Case cases[] = {{0x0001, false}, {0x0100, false}, {0x8020, true},
+                        {0x0040, true},  {0x0800, true},  {0x4000, false}};
   for (const Case& c : cases) {
     rig.emulator->set_status(c.status);
     ASSERT_EQ(rig.cycle(w), HalStatus::ok);  // the answer to the poll sent before the change
@@ -245,7 +246,8 @@ TEST(SocketCanAti, MalformedAndForeignFramesAreCountedDrops) {
   const CanFrame unused_op = make_standard_frame(0x20a, eight, 2);
   const CanFrame short_gauges = make_standard_frame(0x200, eight, 7);
   const CanFrame late_gauges = make_standard_frame(0x201, eight, 6);  // no poll waits for it
-  for (const CanFrame& f : {foreign, extended, remote, unused_op, short_gauges}) ASSERT_EQ(rig.emulator->send_raw(f), CanIo::ok);
+  for (const CanFrame& f : {foreign, extended, remote, unused_op, short_gauges})
+    ASSERT_EQ(rig.emulator->send_raw(f), CanIo::ok);
   const unsigned char junk[5] = {9, 9, 9, 9, 9};
   ASSERT_EQ(rig.sensor_end.send_record(junk, sizeof junk), CanIo::ok);
   // They arrive after the answer to the poll in flight: the sample still completes.
@@ -419,8 +421,8 @@ TEST(SocketCanAti, ReconnectsThroughTheListenerAndSetsUpAgain) {
   int waiting = 0;
   HalStatus s = HalStatus::disconnected;
   while ((s = rig.cycle(w)) == HalStatus::disconnected && waiting < 50) ++waiting;
-  EXPECT_EQ(waiting, 8);                 // the reopen waits one reconnect interval (10 ticks)
-  EXPECT_EQ(s, HalStatus::no_data);      // reconnected; setup starts again
+  EXPECT_EQ(waiting, 8);             // the reopen waits one reconnect interval (10 ticks)
+  EXPECT_EQ(s, HalStatus::no_data);  // reconnected; setup starts again
   EXPECT_FALSE(rig.ft->ready());
   ASSERT_EQ(listener.accept(rig.sensor_end), HalStatus::ok);  // the emulator's side of it
   ASSERT_TRUE(rig.run_setup());
@@ -565,7 +567,7 @@ TEST(SocketCanAti, ReadIsBoundedWhenTheBusFloods) {
   // Ten foreign frames queue behind the answer to the poll in flight.
   const std::uint8_t payload[8] = {};
   for (int i = 0; i < 10; ++i) ASSERT_EQ(rig.emulator->send_raw(make_standard_frame(0x555, payload, 8)), CanIo::ok);
-  ASSERT_EQ(rig.cycle(w), HalStatus::ok);       // answer (2) + 2 foreign
+  ASSERT_EQ(rig.cycle(w), HalStatus::ok);  // answer (2) + 2 foreign
   EXPECT_EQ(rig.ft->protocol_counters().foreign_frames, 2u);
   EXPECT_EQ(rig.cycle(w), HalStatus::no_data);  // 4 foreign
   EXPECT_EQ(rig.cycle(w), HalStatus::no_data);  // 4 foreign

@@ -114,13 +114,15 @@ TEST(SocketCanAtiProtocol, MatrixCountsUnitsSerialFirmwareDecode) {
   EXPECT_EQ(r.matrix[0], 2.0f);
   EXPECT_EQ(r.matrix[1], -1.5f);
   // counts per force 1000000 = 0x000f4240, per torque 2000 = 0x000007d0.
-  ASSERT_EQ(ati::decode_response(frame(0x207, {0x00, 0x0f, 0x42, 0x40, 0, 0, 0x07, 0xd0}), 0x20, r), ati::DecodeError::none);
+  ASSERT_EQ(ati::decode_response(frame(0x207, {0x00, 0x0f, 0x42, 0x40, 0, 0, 0x07, 0xd0}), 0x20, r),
+            ati::DecodeError::none);
   EXPECT_EQ(r.counts_per_force, 1000000u);
   EXPECT_EQ(r.counts_per_torque, 2000u);
   ASSERT_EQ(ati::decode_response(frame(0x208, {1, 2}), 0x20, r), ati::DecodeError::none);
   EXPECT_EQ(r.force_unit, 1);
   EXPECT_EQ(r.torque_unit, 2);
-  ASSERT_EQ(ati::decode_response(frame(0x205, {'F', 'T', '1', '2', '3', '4', '5', '6'}), 0x20, r), ati::DecodeError::none);
+  ASSERT_EQ(ati::decode_response(frame(0x205, {'F', 'T', '1', '2', '3', '4', '5', '6'}), 0x20, r),
+            ati::DecodeError::none);
   EXPECT_EQ(std::memcmp(r.serial, "FT123456", 8), 0);
   ASSERT_EQ(ati::decode_response(frame(0x20f, {3, 7, 0x01, 0x02}), 0x20, r), ati::DecodeError::none);
   EXPECT_EQ(r.firmware_major, 3);
@@ -138,9 +140,11 @@ TEST(SocketCanAtiProtocol, MalformedFramesAreRejectedWithTheirReason) {
   ati::Response r;
   r.status = 0xabcd;
   EXPECT_EQ(ati::decode_response(frame(0x300, {0, 0, 0, 0, 0, 0, 0, 0}), 0x20, r), ati::DecodeError::foreign_id);
-  EXPECT_EQ(ati::decode_response(frame(0x200 | kCanEffFlag, {0, 0, 0, 0, 0, 0, 0, 0}), 0x20, r), ati::DecodeError::foreign_id);
+  EXPECT_EQ(ati::decode_response(frame(0x200 | kCanEffFlag, {0, 0, 0, 0, 0, 0, 0, 0}), 0x20, r),
+            ati::DecodeError::foreign_id);
   EXPECT_EQ(ati::decode_response(frame(0x200 | kCanRtrFlag, {}), 0x20, r), ati::DecodeError::foreign_id);
-  EXPECT_EQ(ati::decode_response(frame(0x200 | kCanErrFlag, {0, 0, 0, 0, 0, 0, 0, 0}), 0x20, r), ati::DecodeError::foreign_id);
+  EXPECT_EQ(ati::decode_response(frame(0x200 | kCanErrFlag, {0, 0, 0, 0, 0, 0, 0, 0}), 0x20, r),
+            ati::DecodeError::foreign_id);
   EXPECT_EQ(ati::decode_response(frame(0x20a, {0}), 0x20, r), ati::DecodeError::unknown_opcode);
   EXPECT_EQ(ati::decode_response(frame(0x20b, {0}), 0x20, r), ati::DecodeError::unknown_opcode);
   EXPECT_EQ(ati::decode_response(frame(0x20c, {}), 0x20, r), ati::DecodeError::unknown_opcode);
@@ -184,7 +188,7 @@ TEST(SocketCanAtiCalibration, UnitCodesConvertToSi) {
   EXPECT_EQ(ati::force_unit_to_newton(0), 0.0);
   EXPECT_EQ(ati::force_unit_to_newton(7), 0.0);
   EXPECT_NEAR(ati::torque_unit_to_newton_metre(1), 0.1129848290276167, 1e-15);  // lbf in
-  EXPECT_NEAR(ati::torque_unit_to_newton_metre(2), 1.3558179483314004, 1e-14);    // lbf ft
+  EXPECT_NEAR(ati::torque_unit_to_newton_metre(2), 1.3558179483314004, 1e-14);  // lbf ft
   EXPECT_DOUBLE_EQ(ati::torque_unit_to_newton_metre(3), 1.0);
   EXPECT_DOUBLE_EQ(ati::torque_unit_to_newton_metre(4), 0.001);
   EXPECT_DOUBLE_EQ(ati::torque_unit_to_newton_metre(5), 0.0980665);

@@ -64,7 +64,7 @@ TEST(SocketCanSeqpacket, MalformedRecordsAreConsumedOneByOne) {
   ASSERT_EQ(SeqpacketCanTransport::make_pair(a, b), HalStatus::ok);
   const unsigned char shortrec[7] = {1, 2, 3, 4, 5, 6, 7};
   unsigned char longrec[40] = {};
-  struct can_frame bad_len{};
+  struct can_frame bad_len {};
   bad_len.can_id = 0x201;
   bad_len.len = 9;
   ASSERT_EQ(a.send_record(shortrec, sizeof shortrec), CanIo::ok);

@@ -44,7 +44,7 @@ struct FakeSysfs {
     write(devices / "1-2" / "serial", "0042\n");
     fs::create_directories(devices / "1-2:1.0" / "net" / "can0");
     write(devices / "1-3.1" / "product", std::string("Xbox NUI Camera\x01\xff\ntrailing", 26));
-    fs::create_directories(devices / "1-3.1:1.0");  // an interface without a netdev
+    fs::create_directories(devices / "1-3.1:1.0");                   // an interface without a netdev
     fs::create_directories(devices / "1-2.5:1.0" / "net" / "can9");  // another device's interface
   }
   std::string root() const { return dir.path().string(); }

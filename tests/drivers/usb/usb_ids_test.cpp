@@ -1,4 +1,4 @@
-// drivers/usb usb_ids: lookups of the VID:PID table (HARDWARE.md section 5).
+// drivers/usb usb_ids: lookups of the VID:PID table (docs/drivers/usb.md).
 #include <gtest/gtest.h>
 
 #include <set>

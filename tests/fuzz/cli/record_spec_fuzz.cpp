@@ -30,7 +30,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const std::string kind = device_kind_name(spec.kind);
     check(text.substr(0, kind.size() + 1) == kind + ":");
     switch (spec.kind) {
-      case DeviceKind::ati_can: check(spec.can_id <= 0x7f && !spec.location.empty() && spec.location.size() <= 15); break;
+      case DeviceKind::ati_can:
+        check(spec.can_id <= 0x7f && !spec.location.empty() && spec.location.size() <= 15);
+        break;
       case DeviceKind::robotous_can:
         check(spec.can_id <= 0x7ff && spec.can_response_1 <= 0x7ff && spec.can_response_2 <= 0x7ff);
         check(spec.can_id != spec.can_response_1 && spec.can_id != spec.can_response_2 &&

@@ -81,9 +81,9 @@ class InputBackend final : public lc::CaptureBackend {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 8) return 0;
-  static const lc::RawFormat formats[] = {lc::RawFormat::rgb888, lc::RawFormat::bgr888, lc::RawFormat::xrgb8888,
-                                          lc::RawFormat::xbgr8888, lc::RawFormat::yuyv, lc::RawFormat::uyvy,
-                                          lc::RawFormat::nv12, lc::RawFormat::nv21, lc::RawFormat::r8,
+  static const lc::RawFormat formats[] = {lc::RawFormat::rgb888,     lc::RawFormat::bgr888, lc::RawFormat::xrgb8888,
+                                          lc::RawFormat::xbgr8888,   lc::RawFormat::yuyv,   lc::RawFormat::uyvy,
+                                          lc::RawFormat::nv12,       lc::RawFormat::nv21,   lc::RawFormat::r8,
                                           lc::RawFormat::unsupported};
   const lc::RawFormat format = formats[data[0] % 10];
   const auto out_format = static_cast<PixelFormat>(data[1] % 4);
@@ -130,8 +130,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::size_t pixel = out_format == PixelFormat::mono8 ? 1 : 3;
   const std::size_t out_stride = static_cast<std::size_t>(width) * pixel + 5;
   std::vector<std::uint8_t> out(out_stride * static_cast<std::size_t>(height), 0xA5);
-  const lc::ConvertStatus status =
-      assembled ? lc::convert_raw(image, out_format, out.data(), out_stride, out.size()) : lc::ConvertStatus::short_buffer;
+  const lc::ConvertStatus status = assembled ? lc::convert_raw(image, out_format, out.data(), out_stride, out.size())
+                                             : lc::ConvertStatus::short_buffer;
   if (status == lc::ConvertStatus::ok) {
     for (int y = 0; y < height; ++y) {  // the padding after each row is never written
       for (std::size_t k = static_cast<std::size_t>(width) * pixel; k < out_stride; ++k) {

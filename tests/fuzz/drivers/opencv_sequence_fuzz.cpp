@@ -33,7 +33,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string_view pattern_text = rest.substr(0, cut);
   const std::string_view other = rest.substr(cut);
   std::uint64_t index = 0;
-  for (std::size_t i = 0; i < 8 && i < rest.size(); ++i) index |= static_cast<std::uint64_t>(static_cast<unsigned char>(rest[i])) << (8 * i);
+  for (std::size_t i = 0; i < 8 && i < rest.size(); ++i)
+    index |= static_cast<std::uint64_t>(static_cast<unsigned char>(rest[i])) << (8 * i);
 
   oc::SequencePattern pattern;
   std::string error;
@@ -43,9 +44,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     check(name.size() >= pattern.prefix.size() + pattern.suffix.size() + 1);
     check(name.compare(0, pattern.prefix.size(), pattern.prefix) == 0);
     check(name.compare(name.size() - pattern.suffix.size(), pattern.suffix.size(), pattern.suffix) == 0);
-    const std::string digits = name.substr(pattern.prefix.size(), name.size() - pattern.prefix.size() - pattern.suffix.size());
+    const std::string digits =
+        name.substr(pattern.prefix.size(), name.size() - pattern.prefix.size() - pattern.suffix.size());
     const std::string plain = std::to_string(index);
-    check(digits.size() == (plain.size() > static_cast<std::size_t>(pattern.width) ? plain.size() : static_cast<std::size_t>(pattern.width)));
+    check(digits.size() == (plain.size() > static_cast<std::size_t>(pattern.width)
+                                ? plain.size()
+                                : static_cast<std::size_t>(pattern.width)));
     check(digits.compare(digits.size() - plain.size(), plain.size(), plain) == 0);
     for (std::size_t k = 0; k + plain.size() < digits.size(); ++k) check(digits[k] == (pattern.zero_pad ? '0' : ' '));
     // Zero-padded names of increasing indices sort naturally in index order (space padding

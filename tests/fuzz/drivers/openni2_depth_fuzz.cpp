@@ -51,7 +51,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (check_intrinsics(from_fov) != IntrinsicsCheck::ok) std::abort();
   }
 
-  const std::size_t pixels = width > 0 && height > 0 ? static_cast<std::size_t>(width) * static_cast<std::size_t>(height) : 0;
+  const std::size_t pixels =
+      width > 0 && height > 0 ? static_cast<std::size_t>(width) * static_cast<std::size_t>(height) : 0;
   const std::size_t capacity = pixels > 0 ? pixels - (same_size >> 7) : 0;  // sometimes one short
   std::vector<std::uint16_t> packed(capacity + 1, 0xABCD);
   const bool copied = copy_depth_image(data, size, width, height, stride, packed.data(), capacity);

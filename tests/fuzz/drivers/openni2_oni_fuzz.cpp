@@ -22,7 +22,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   for (const OniNodeInfo& node : info.nodes) {
     if (node.data_records == 0) continue;
     any_data = true;
-    if (node.first_frame == 0 || node.last_frame > node.frames_declared || node.first_frame > node.last_frame) std::abort();
+    if (node.first_frame == 0 || node.last_frame > node.frames_declared || node.first_frame > node.last_frame)
+      std::abort();
     if (node.last_timestamp_us > info.max_timestamp_us) std::abort();
     if (node.data_records > node.last_frame - node.first_frame + 1) std::abort();
   }

@@ -48,11 +48,11 @@ std::string write_inputs(const PressScene& scene, const fs::path& root) {
   const Eigen::Quaterniond q(scene.camera_to_world.linear());
   const Eigen::Vector3d t = scene.camera_to_world.translation();
   char pose[256];
-  std::snprintf(pose, sizeof pose, "%.9f,%.9f,%.9f,%.12f,%.12f,%.12f,%.12f", t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
+  std::snprintf(pose, sizeof pose, "%.9f,%.9f,%.9f,%.12f,%.12f,%.12f,%.12f", t.x(), t.y(), t.z(), q.x(), q.y(), q.z(),
+                q.w());
   const vision::PixelRect& r = scene.cloud.region;
-  return " --noise 0.0005 --camera-pose " + std::string(pose) +
-         " --region " + std::to_string(r.u0) + "," + std::to_string(r.v0) + "," + std::to_string(r.width) + "," +
-         std::to_string(r.height);
+  return " --noise 0.0005 --camera-pose " + std::string(pose) + " --region " + std::to_string(r.u0) + "," +
+         std::to_string(r.v0) + "," + std::to_string(r.width) + "," + std::to_string(r.height);
 }
 
 class TrackDepthCli : public ::testing::Test {
@@ -122,8 +122,9 @@ TEST_F(TrackDepthCli, TracksTheSequenceIntoARecording) {
 TEST_F(TrackDepthCli, RecordersDepthFramesCarryScaleAndIntrinsics) {
   TempDir out;
   const std::string plan = quoted((root_->path() / "plan").string());
-  const CommandResult r = run_pliant("track-depth " + plan + " " + quoted((root_->path() / "depth_frames.csv").string()) +
-                                     *placement_ + " -o " + quoted(out / "t"));
+  const CommandResult r =
+      run_pliant("track-depth " + plan + " " + quoted((root_->path() / "depth_frames.csv").string()) + *placement_ +
+                 " -o " + quoted(out / "t"));
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("(pliant record depth_frames.csv), 640x480, 0.1 mm per unit"), std::string::npos) << r.out;
   const host::Recording tracked = host::read_recording(out / "t");
@@ -184,9 +185,10 @@ TEST(TrackDepthOni, RealKinectRecordingRunsEndToEnd) {
   ASSERT_GT(motion.size(), 11u * 300u);
   std::sort(motion.begin(), motion.end());
   const double p90 = motion[motion.size() * 9 / 10], p99 = motion[motion.size() * 99 / 100];
-  std::printf("room.oni: %d particles, %zu observed particle-frames; motion / Kinect depth sd: p90 %.2f, p99 %.2f, "
-              "max %.2f\n",
-              tracked.particle_count, motion.size(), p90, p99, motion.back());
+  std::printf(
+      "room.oni: %d particles, %zu observed particle-frames; motion / Kinect depth sd: p90 %.2f, p99 %.2f, "
+      "max %.2f\n",
+      tracked.particle_count, motion.size(), p90, p99, motion.back());
   EXPECT_LT(p90, 1.0);
   EXPECT_LT(p99, 2.5);
   EXPECT_LT(motion.back(), 5.0);
@@ -195,8 +197,8 @@ TEST(TrackDepthOni, RealKinectRecordingRunsEndToEnd) {
 
 TEST_F(TrackDepthCli, RoundsPrintTheirEstimates) {
   TempDir out;
-  const CommandResult r =
-      run_pliant("track-depth " + inputs() + *camera_ + " --rounds 2 --msm-beta 0.3 --all-tracked -o " + quoted(out / "t"));
+  const CommandResult r = run_pliant("track-depth " + inputs() + *camera_ +
+                                     " --rounds 2 --msm-beta 0.3 --all-tracked -o " + quoted(out / "t"));
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("round 1: prior msm_beta 0.3 -> estimate"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("every tracked position"), std::string::npos) << r.out;
@@ -224,7 +226,8 @@ TEST_F(TrackDepthCli, MalformedInputIsOneLineAndStatusTwo) {
   expect_usage(inputs() + *camera_ + " --rounds 0", "--rounds must be between 1 and 10");
   expect_usage(inputs() + *camera_ + " --msm-beta 2", "--msm-beta must be in [0, 1]");
   expect_usage(inputs() + *camera_ + " --correspondence edge", "--correspondence must be plane or point");
-  expect_usage(inputs() + " --intrinsics 525,525,319.5,239.5 --camera-pose 0,0,0,0,0,0,3", "quaternion must have norm 1");
+  expect_usage(inputs() + " --intrinsics 525,525,319.5,239.5 --camera-pose 0,0,0,0,0,0,3",
+               "quaternion must have norm 1");
   expect_usage(inputs() + " --intrinsics 525,525,319.5,239.5 --region 600,0,100,10", "is not inside the 640x480 image");
   expect_usage(plan + " " + quoted((root_->path() / "missing.txt").string()) + *camera_, "missing.txt: cannot open");
   expect_usage(quoted((root_->path() / "no-plan").string()) + " " + list + *camera_, "no-plan");
@@ -244,13 +247,15 @@ TEST_F(TrackDepthCli, MalformedInputIsOneLineAndStatusTwo) {
   expect_usage(plan + " " + quoted((bad / "eight.txt").string()) + *camera_, "must be 16-bit");
   expect_usage(plan + " " + quoted((bad / "sizes.txt").string()) + *camera_,
                "depth image is 320x240 but the intrinsics are for 640x480");
-  expect_usage(plan + " " + quoted((bad / "order.txt").string()) + *camera_, "order.txt:2: timestamp '0.1' does not follow");
+  expect_usage(plan + " " + quoted((bad / "order.txt").string()) + *camera_,
+               "order.txt:2: timestamp '0.1' does not follow");
   // An .oni that is not one: refused before OpenNI2 parses it (or, without drivers/openni2,
   // because the build cannot read .oni at all).
   write_text(bad / "junk.oni", "NI10 is not enough");
   expect_usage(plan + " " + quoted((bad / "junk.oni").string()) + *camera_, "junk.oni: ");
   // A recorder's list whose scale is broken.
-  write_text(bad / "depth_frames.csv", "index,t,file,depth_scale_m,fx,fy,cx,cy\n0,0,first.png,-1,525,525,319.5,239.5\n");
+  write_text(bad / "depth_frames.csv",
+             "index,t,file,depth_scale_m,fx,fy,cx,cy\n0,0,first.png,-1,525,525,319.5,239.5\n");
   expect_usage(plan + " " + quoted((bad / "depth_frames.csv").string()) + *placement_,
                "depth_frames.csv:2: depth_scale_m '-1' is not a positive number");
 

@@ -38,7 +38,8 @@ TEST(DepthTrackerAllocation, OnlyTheKdTreePoolPerFrame) {
   auto step = [&](int f) {
     driven_targets_at(scene.plan, scene.truth.recording.frame_times_s[static_cast<std::size_t>(f)], ids, targets);
     const MsmDrivenTargets<3, double> driven{ids.data(), targets.data(), static_cast<int>(ids.size())};
-    reports[static_cast<std::size_t>(f)] = tracker.update(frames[static_cast<std::size_t>(f)].view(), scene.dt(f), driven);
+    reports[static_cast<std::size_t>(f)] =
+        tracker.update(frames[static_cast<std::size_t>(f)].view(), scene.dt(f), driven);
   };
   step(1);
   ids.reserve(4);

@@ -58,7 +58,8 @@ TEST(DepthCloud, BackProjectsPixelsToTheirRays) {
 TEST(DepthCloud, EveryPointProjectsBackToItsPixel) {
   const PinholeIntrinsics k{517.3, 516.5, 318.6, 255.3, 640, 480};
   DepthImage image = constant_image(640, 480, 0);
-  for (std::size_t i = 0; i < image.data.size(); ++i) image.data[i] = static_cast<std::uint16_t>(2000 + (i * 7919) % 20000);
+  for (std::size_t i = 0; i < image.data.size(); ++i)
+    image.data[i] = static_cast<std::uint16_t>(2000 + (i * 7919) % 20000);
   DepthCloud cloud;
   ASSERT_EQ(depth_to_cloud(image.view(), k, DepthToCloudOptions{}, cloud), 640u * 480u);
   double worst = 0;
@@ -119,8 +120,8 @@ TEST(DepthCloud, StrideRegionAndRange) {
 
 TEST(DepthCloud, PaddedRowsAreRespected) {
   // A 4x3 image inside rows of 6 elements (padding 99 must never be read as depth).
-  const std::vector<std::uint16_t> padded = {1000, 1000, 1000, 1000, 99, 99, 2000, 2000, 2000, 2000, 99, 99,
-                                             3000, 3000, 3000, 3000, 99, 99};
+  const std::vector<std::uint16_t> padded = {1000, 1000, 1000, 1000, 99,   99,   2000, 2000, 2000,
+                                             2000, 99,   99,   3000, 3000, 3000, 3000, 99,   99};
   const DepthImageView view{padded.data(), 4, 3, 6};
   DepthCloud cloud;
   ASSERT_EQ(depth_to_cloud(view, PinholeIntrinsics{100, 100, 1.5, 1, 4, 3}, DepthToCloudOptions{}, cloud), 12u);
@@ -151,7 +152,8 @@ TEST(DepthCloud, MalformedInputIsAClearError) {
   const DepthImage image = constant_image(640, 480, 1000);
   DepthCloud cloud;
   const DepthToCloudOptions good;
-  auto message = [&](const DepthImageView& view, const PinholeIntrinsics& intrinsics, const DepthToCloudOptions& options) {
+  auto message = [&](const DepthImageView& view, const PinholeIntrinsics& intrinsics,
+                     const DepthToCloudOptions& options) {
     return error_of([&] { depth_to_cloud(view, intrinsics, options, cloud); });
   };
   // Wrong size.
@@ -164,7 +166,8 @@ TEST(DepthCloud, MalformedInputIsAClearError) {
   far.min_depth_m = 2.0;
   EXPECT_NE(message(image.view(), k, far).find("no valid pixel"), std::string::npos);
   // Missing or bad intrinsics.
-  EXPECT_EQ(message(image.view(), PinholeIntrinsics{}, good), "intrinsics: fx must be finite and > 0 (missing intrinsics?)");
+  EXPECT_EQ(message(image.view(), PinholeIntrinsics{}, good),
+            "intrinsics: fx must be finite and > 0 (missing intrinsics?)");
   PinholeIntrinsics bad = k;
   bad.fy = -1;
   EXPECT_NE(message(image.view(), bad, good).find("fy"), std::string::npos);
@@ -243,7 +246,8 @@ TEST(DepthCloud, CameraPoseAndRegionFromText) {
   EXPECT_EQ(region_error("0,0,0,5"), "region: width and height must be >= 1");
   EXPECT_EQ(region_error("0,0,1e12,5"), "region: width must be a whole number >= 0");
   EXPECT_EQ(region_error("0,0,5"), "region: height is missing (expected u0,v0,width,height)");
-  EXPECT_EQ(region_error(std::string(60, '7') + ",0,1,1"), "region: u0 is not a number: '" + std::string(40, '7') + "...'");
+  EXPECT_EQ(region_error(std::string(60, '7') + ",0,1,1"),
+            "region: u0 is not a number: '" + std::string(40, '7') + "...'");
 }
 
 TEST(DepthPng, ReadsSixteenBitAndRefusesTheRest) {
@@ -251,7 +255,8 @@ TEST(DepthPng, ReadsSixteenBitAndRefusesTheRest) {
   // A 16-bit single-channel PNG round trip.
   cv::Mat depth(3, 5, CV_16UC1);
   for (int v = 0; v < 3; ++v) {
-    for (int u = 0; u < 5; ++u) depth.at<std::uint16_t>(v, u) = static_cast<std::uint16_t>(1000 * v + u + 60000 * (u == 4));
+    for (int u = 0; u < 5; ++u)
+      depth.at<std::uint16_t>(v, u) = static_cast<std::uint16_t>(1000 * v + u + 60000 * (u == 4));
   }
   ASSERT_TRUE(cv::imwrite(dir / "depth.png", depth));
   const DepthImage image = read_depth_png(dir / "depth.png");
@@ -305,7 +310,9 @@ TEST(DepthPng, ReadsSixteenBitAndRefusesTheRest) {
   crc ^= 0xffffffffu;
   for (int b = 0; b < 4; ++b) claim[static_cast<std::size_t>(29 + b)] = static_cast<char>((crc >> (24 - 8 * b)) & 0xff);
   claim += std::string("\0\0\0\x64IDAT", 8) + std::string(100, '\0');
-  EXPECT_EQ(error_of([&] { decode_depth_png(reinterpret_cast<const std::uint8_t*>(claim.data()), claim.size(), "claim.png"); }),
+  EXPECT_EQ(error_of([&] {
+              decode_depth_png(reinterpret_cast<const std::uint8_t*>(claim.data()), claim.size(), "claim.png");
+            }),
             "claim.png: corrupt PNG (141 bytes cannot hold a 16000x16000 image)");
   EXPECT_THROW(decode_depth_png(nullptr, 0, "x"), DepthError);
 }

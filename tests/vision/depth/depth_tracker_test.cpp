@@ -158,7 +158,8 @@ TEST(DepthTracker, MovingOccluderDoesNotLoseTheParticles) {
   double covered_sq = 0, covered_worst = 0, covered_motion = 0;
   for (int f = 1; f < blocked.frames(); ++f) {
     for (int i = 0; i < 100; ++i) {
-      if (view_of(open, f, i) != ParticleView::observed || view_of(hidden, f, i) != ParticleView::behind_surface) continue;
+      if (view_of(open, f, i) != ParticleView::observed || view_of(hidden, f, i) != ParticleView::behind_surface)
+        continue;
       ++covered;
       const host::Recording& r = hidden.recording;
       const Eigen::Vector3d x(r.position(f, i, 0), r.position(f, i, 1), r.position(f, i, 2));
@@ -168,8 +169,8 @@ TEST(DepthTracker, MovingOccluderDoesNotLoseTheParticles) {
       covered_motion = std::max(covered_motion, (blocked.truth_at(f, i) - blocked.truth_at(0, i)).norm());
     }
   }
-  ASSERT_GT(covered, 200);               // the bar really hid particles, for many frames
-  ASSERT_GT(covered_motion, 1.5e-3);     // while they moved
+  ASSERT_GT(covered, 200);            // the bar really hid particles, for many frames
+  ASSERT_GT(covered_motion, 1.5e-3);  // while they moved
   // Nobody hidden long enough to be lost: only the never-visible particles are, as without it.
   EXPECT_EQ(hidden.core.lost_events, open.core.lost_events);
   // Hidden particles follow the model and their neighbours: within the depth noise (measured
@@ -222,7 +223,8 @@ TEST_P(DepthTrackerEstimate, RecoversMsmBetaFromTheTrackedRecording) {
   EXPECT_EQ(rounds.priors[1], rounds.estimates[0].result.msm_beta);
   // Round 1 (measured: 0.495, 0.531, 0.297) has closed at least 80 % of the prior's gap.
   const double first = rounds.estimates[0].result.msm_beta;
-  EXPECT_LT(std::abs(first - c.truth), 0.2 * std::abs(c.prior - c.truth)) << "truth " << c.truth << " prior " << c.prior;
+  EXPECT_LT(std::abs(first - c.truth), 0.2 * std::abs(c.prior - c.truth))
+      << "truth " << c.truth << " prior " << c.prior;
   // Round 2 (measured: 0.501, 0.506, 0.261), from the written recording read back from disk.
   test_support::TempDir dir("pliant_depth_");
   host::write_recording(rounds.tracked.recording, dir / "tracked");
@@ -354,9 +356,9 @@ TEST(DepthTracker, RestNormalsOfALattice) {
   const PressScene scene(0.5, 0.5e-3);
   auto model = host::build_msm_model<3>(scene.plan, host::MsmSetupOptions{});
   const std::vector<Eigen::Vector3d> normals = estimate_rest_normals(model->model);
-  EXPECT_TRUE(normals[37].isZero());                                    // (2, 2, 1) interior
-  EXPECT_NEAR(normals[87].dot(Eigen::Vector3d::UnitZ()), 1.0, 1e-9);    // (2, 2, 3) top face
-  EXPECT_NEAR(normals[52].dot(-Eigen::Vector3d::UnitY()), 1.0, 1e-9);   // (2, 0, 2) front face
+  EXPECT_TRUE(normals[37].isZero());                                         // (2, 2, 1) interior
+  EXPECT_NEAR(normals[87].dot(Eigen::Vector3d::UnitZ()), 1.0, 1e-9);         // (2, 2, 3) top face
+  EXPECT_NEAR(normals[52].dot(-Eigen::Vector3d::UnitY()), 1.0, 1e-9);        // (2, 0, 2) front face
   EXPECT_GT(normals[79].dot(Eigen::Vector3d(1, -1, 1).normalized()), 0.95);  // (4, 0, 3) corner
 }
 
@@ -378,12 +380,13 @@ TEST(DepthTracker, SeedsLieOnTheVisibleSurface) {
     const Eigen::Vector3d& p = seeds.positions[k];
     // On the rendered surface: its depth is the exact depth of its pixel, within 5 noise sd.
     const Eigen::Vector2d pixel = renderer.project(p);
-    const double exact = renderer.depth(static_cast<int>(std::lround(pixel.x())), static_cast<int>(std::lround(pixel.y())));
+    const double exact =
+        renderer.depth(static_cast<int>(std::lround(pixel.x())), static_cast<int>(std::lround(pixel.y())));
     EXPECT_LT(std::abs((world_to_camera * p).z() - exact), 5 * scene.noise_m) << p.transpose();
     EXPECT_NEAR(seeds.normals[k].norm(), 1.0, 1e-9);
     // Normals of seeds well inside one face (2 mm from its edges) point out of that face.
-    const bool in_x = p.x() > 0.002 && p.x() < 0.038, in_y = p.y() > 0.002 && p.y() < 0.038,
-               in_z = p.z() > 0.002 && p.z() < 0.028;
+    const bool in_x =
+        p.x() > 0.002 && p.x()<0.038, in_y = p.y()> 0.002 && p.y()<0.038, in_z = p.z()> 0.002 && p.z() < 0.028;
     const bool off_block = p.x() < -0.003 || p.x() > 0.043 || p.y() < -0.003 || p.y() > 0.043;
     Eigen::Vector3d face = Eigen::Vector3d::Zero();
     if (std::abs(p.z() - 0.03) < 1e-3 && in_x && in_y && (p - scene.truth_at(0, scene.tool)).norm() > 0.008) {

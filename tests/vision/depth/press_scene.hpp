@@ -92,7 +92,8 @@ struct PressScene {
   void render(int frame, DepthRenderer& renderer) const {
     renderer.clear();
     const host::Recording& r = truth.recording;
-    const double* x = r.positions.data() + static_cast<std::size_t>(frame) * static_cast<std::size_t>(r.particle_count) * 3;
+    const double* x =
+        r.positions.data() + static_cast<std::size_t>(frame) * static_cast<std::size_t>(r.particle_count) * 3;
     renderer.add(lattice_surface(x, kNx, kNy, kNz));
     renderer.add(Triangle{{-0.06, -0.06, 0}, {0.10, -0.06, 0}, {0.10, 0.10, 0}});  // the table
     renderer.add(Triangle{{-0.06, -0.06, 0}, {0.10, 0.10, 0}, {-0.06, 0.10, 0}});

@@ -120,7 +120,8 @@ std::vector<Triangle> lattice_surface(const double* x, int nx, int ny, int nz) {
     return Eigen::Vector3d(p[0], p[1], p[2]);
   };
   std::vector<Triangle> out;
-  auto quad = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, const Eigen::Vector3d& d) {
+  auto quad = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                  const Eigen::Vector3d& d) {
     out.push_back({a, b, c});
     out.push_back({a, c, d});
   };

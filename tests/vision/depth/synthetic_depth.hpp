@@ -25,8 +25,8 @@ Eigen::Isometry3d look_at(const Eigen::Vector3d& eye, const Eigen::Vector3d& tar
 class DepthRenderer {
  public:
   DepthRenderer(const PinholeIntrinsics& intrinsics, const Eigen::Isometry3d& camera_to_world);
-  void clear();                                   ///< every pixel empty (infinite depth)
-  void add(const Triangle& triangle);             ///< rasterised into the z-buffer
+  void clear();                        ///< every pixel empty (infinite depth)
+  void add(const Triangle& triangle);  ///< rasterised into the z-buffer
   void add(const std::vector<Triangle>& triangles);
   /// Axis-aligned box [low, high] (world).
   void add_box(const Eigen::Vector3d& low, const Eigen::Vector3d& high);

@@ -87,7 +87,8 @@ PressScene::PressScene(const PressSceneConfig& config) : config_(config) {
   };
   snapshot();
   for (int k = 1; k < frames; ++k) {
-    const double progress = std::clamp(static_cast<double>(k - config.still_frames + 1) / config.press_frames, 0.0, 1.0);
+    const double progress =
+        std::clamp(static_cast<double>(k - config.still_frames + 1) / config.press_frames, 0.0, 1.0);
     Eigen::Vector2d target = model.rest[tool];
     target(1) += config.depth_px * progress;
     MsmStepInput<2, double> in;
@@ -101,7 +102,9 @@ PressScene::PressScene(const PressSceneConfig& config) : config_(config) {
   const int prow = rows + 2 * kPad, pcol = cols + 2 * kPad;
   for (const std::vector<cv::Point2d>& positions : truth_) {
     std::vector<cv::Point2d> pad(static_cast<std::size_t>(prow * pcol));
-    const auto at = [&](int r, int c) -> cv::Point2d& { return pad[static_cast<std::size_t>((r + kPad) * pcol + c + kPad)]; };
+    const auto at = [&](int r, int c) -> cv::Point2d& {
+      return pad[static_cast<std::size_t>((r + kPad) * pcol + c + kPad)];
+    };
     for (int r = 0; r < rows; ++r) {
       for (int c = 0; c < cols; ++c) {
         const std::size_t i = static_cast<std::size_t>(r * cols + c);
@@ -122,8 +125,8 @@ PressScene::PressScene(const PressSceneConfig& config) : config_(config) {
     for (int k = 0; k < kWaves; ++k) {
       const double wavelength = 6.0 * std::pow(5.0, rng.uniform());  // 6 .. 30 px
       const double angle = 2 * kPi * rng.uniform();
-      layer.push_back({2 * kPi * std::cos(angle) / wavelength, 2 * kPi * std::sin(angle) / wavelength,
-                       2 * kPi * rng.uniform()});
+      layer.push_back(
+          {2 * kPi * std::cos(angle) / wavelength, 2 * kPi * std::sin(angle) / wavelength, 2 * kPi * rng.uniform()});
     }
   }
 }
@@ -157,7 +160,8 @@ double PressScene::texture(const cv::Point2d& u, int layer) const {
 cv::Rect2d PressScene::occluder(int frame) const {
   if (config_.occluder_width <= 0 || frame < config_.occluder_from) return {};
   const double x = config_.occluder_x0 + (frame - config_.occluder_from) * config_.occluder_speed_px;
-  return {x, config_.occluder_y, static_cast<double>(config_.occluder_width), static_cast<double>(config_.occluder_height)};
+  return {x, config_.occluder_y, static_cast<double>(config_.occluder_width),
+          static_cast<double>(config_.occluder_height)};
 }
 
 bool PressScene::hidden(int frame, int id, double margin_px) const {

@@ -55,7 +55,9 @@ class PressScene {
   int particle_count() const { return config_.rows * config_.cols; }
   const PressSceneConfig& config() const { return config_; }
   /// True particle position in frame k (px).
-  cv::Point2d truth(int frame, int id) const { return truth_[static_cast<std::size_t>(frame)][static_cast<std::size_t>(id)]; }
+  cv::Point2d truth(int frame, int id) const {
+    return truth_[static_cast<std::size_t>(frame)][static_cast<std::size_t>(id)];
+  }
   /// Frame k, CV_8UC1.
   cv::Mat render(int frame) const;
   std::vector<cv::Mat> render_all() const;

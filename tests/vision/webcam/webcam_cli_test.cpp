@@ -53,8 +53,8 @@ struct CommandResult {
 
 CommandResult run_pliant(const std::string& arguments) {
   TempDir capture;
-  const std::string command = quoted(PLIANT_EXE) + " " + arguments + " </dev/null >" + quoted(capture / "out") +
-                              " 2>" + quoted(capture / "err");
+  const std::string command = quoted(PLIANT_EXE) + " " + arguments + " </dev/null >" + quoted(capture / "out") + " 2>" +
+                              quoted(capture / "err");
   const int raw = std::system(command.c_str());
   CommandResult r;
   r.status = raw != -1 && WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
@@ -70,7 +70,8 @@ struct RenderedPress {
   std::vector<cv::Mat> frames;
   RenderedPress() {
     frames = scene.render_all();
-    for (std::size_t k = 0; k < frames.size(); ++k) test::write_png(dir / cv::format("frame_%03d.png", static_cast<int>(k)), frames[k]);
+    for (std::size_t k = 0; k < frames.size(); ++k)
+      test::write_png(dir / cv::format("frame_%03d.png", static_cast<int>(k)), frames[k]);
   }
   std::string pattern() const { return dir / "frame_%03d.png"; }
   std::string region() const { return " --roi " + scene.roi() + " --grid " + scene.grid(); }
@@ -100,7 +101,8 @@ TEST(webcam_cli, TrackThenEstimateRecoversTheRenderedMsmBeta) {
   const RenderedPress& p = press();
   TempDir dir;
   const std::string rec = dir / "rec";
-  const CommandResult r = run_pliant("track " + quoted(p.pattern()) + " --fps 10" + p.region() + " -q -o " + quoted(rec));
+  const CommandResult r =
+      run_pliant("track " + quoted(p.pattern()) + " --fps 10" + p.region() + " -q -o " + quoted(rec));
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(r.err, "");
   EXPECT_TRUE(contains(r.out, "wrote " + rec + ": 32 particles (4x8 grid) x 30 frames at 10 Hz, dis flow")) << r.out;
@@ -168,8 +170,8 @@ TEST(webcam_cli, MalformedInputIsRefusedAndWritesNothing) {
   const std::string out = " -q -o " + quoted(rec);
 
   test::write_bytes(dir / "garbage.avi", std::string(2048, '\x13'));
-  expect_refused(run_pliant("track " + quoted(dir / "garbage.avi") + region + out), "garbage.avi: cannot open the video",
-                 dir.path());
+  expect_refused(run_pliant("track " + quoted(dir / "garbage.avi") + region + out),
+                 "garbage.avi: cannot open the video", dir.path());
   expect_refused(run_pliant("track " + quoted(dir / "missing.avi") + region + out), "missing.avi: no such file",
                  dir.path());
   expect_refused(run_pliant("track " + quoted(dir / "none_%03d.png") + region + out), "no file for number 0 or 1",
@@ -213,8 +215,8 @@ TEST(webcam_cli, MalformedInputIsRefusedAndWritesNothing) {
   }
   expect_refused(run_pliant("track " + quoted(dir / "sized/f_%d.png") + region + out),
                  "f_4.png: 300x240, the first frame is 320x240", dir.path());
-  expect_refused(run_pliant("track " + quoted(dir / "damaged/f_%d.png") + region + out), "f_3.png: cannot read the image",
-                 dir.path());
+  expect_refused(run_pliant("track " + quoted(dir / "damaged/f_%d.png") + region + out),
+                 "f_3.png: cannot read the image", dir.path());
 
   // Nothing moves, roles to detect: refused.
   fs::create_directory(dir / "still");

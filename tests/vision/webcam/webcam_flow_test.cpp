@@ -97,7 +97,9 @@ TEST_P(DenseFlowTest, RecoversATranslation) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Methods, DenseFlowTest, ::testing::Values(FlowMethod::dis, FlowMethod::farneback),
-                         [](const ::testing::TestParamInfo<FlowMethod>& param) { return flow_method_name(param.param); });
+                         [](const ::testing::TestParamInfo<FlowMethod>& param) {
+                           return flow_method_name(param.param);
+                         });
 
 TEST(webcam_flow, MethodNamesAndSettings) {
   EXPECT_EQ(parse_flow_method("dis"), FlowMethod::dis);
@@ -155,8 +157,8 @@ TEST(webcam_flow, AdvectorObservesMovingParticlesAndNotCoveredOnes) {
     ASSERT_EQ(out.size(), 3u);
     for (std::size_t i = 0; i < 3; ++i) {
       const bool hidden = covered && i == 1;
-      EXPECT_EQ(out[i].usable(), !hidden) << "frame " << k << " particle " << i << " "
-                                          << observation_kind_name(out[i].kind);
+      EXPECT_EQ(out[i].usable(), !hidden)
+          << "frame " << k << " particle " << i << " " << observation_kind_name(out[i].kind);
       if (out[i].usable()) {
         EXPECT_NEAR(out[i].position.x, start[i].x + k, 0.1) << k << " " << i;
         EXPECT_NEAR(out[i].position.y, start[i].y, 0.1) << k << " " << i;

@@ -85,7 +85,8 @@ TEST(webcam_frames, GlobIsSortedByName) {
 
 TEST(webcam_frames, ImageSequenceIsReadInOrderAtItsRate) {
   TempDir dir;
-  for (int i = 0; i < 4; ++i) test::write_png(dir / cv::format("f_%02d.png", i), test::random_texture(20, 10, static_cast<unsigned>(i)));
+  for (int i = 0; i < 4; ++i)
+    test::write_png(dir / cv::format("f_%02d.png", i), test::random_texture(20, 10, static_cast<unsigned>(i)));
   expect_input_error([&] { open_frame_source(dir / "f_%02d.png", 0); }, "needs its frame rate (--fps)");
   auto source = open_frame_source(dir / "f_%02d.png", 0, 30);
   EXPECT_DOUBLE_EQ(source->fps(), 30);

@@ -94,8 +94,8 @@ TEST(webcam_grid, UnusableRegionsAreRefused) {
 }
 
 TEST(webcam_grid, MalformedOptionTextIsRefused) {
-  for (const char* text : {"", "1,2,3", "1,2,3,4,5", "a,b,c,d", "1,2,-3,4", "1,2,3,4x", "1.5,2,3,4", ",,,",
-                           "99999999999999,1,1,1"}) {
+  for (const char* text :
+       {"", "1,2,3", "1,2,3,4,5", "a,b,c,d", "1,2,-3,4", "1,2,3,4x", "1.5,2,3,4", ",,,", "99999999999999,1,1,1"}) {
     expect_input_error([&] { parse_roi(text); }, "--roi: expected x,y,w,h");
   }
   for (const char* text : {"", "4", "4x", "x8", "4x8x2", "0x8", "4x-8", "4*8", "1001x1", "4 x 8"}) {

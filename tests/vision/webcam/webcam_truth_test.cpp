@@ -132,8 +132,7 @@ TEST_P(webcam_truth_beta, ChainRecoversTheRenderedMsmBeta) {
   EXPECT_NEAR(beta, config.msm_beta, kBetaTolerance);
 }
 
-INSTANTIATE_TEST_SUITE_P(range, webcam_truth_beta,
-                         ::testing::Values(BetaCase{0.2, 3}, BetaCase{0.8, 3}),
+INSTANTIATE_TEST_SUITE_P(range, webcam_truth_beta, ::testing::Values(BetaCase{0.2, 3}, BetaCase{0.8, 3}),
                          [](const ::testing::TestParamInfo<BetaCase>& param) {
                            return "beta_" + std::to_string(static_cast<int>(param.param.msm_beta * 100));
                          });

@@ -44,8 +44,8 @@ using ProgressCallback = void (*)(void* context, int done, int planned_total);
 
 struct DeformabilityConfig {
   FitMode mode = FitMode::trajectory;
-  int grid_points = 11;         ///< >= 3, uniform over [0, 1]
-  double tolerance = 1e-3;      ///< final bracket width on msm_beta
+  int grid_points = 11;     ///< >= 3, uniform over [0, 1]
+  double tolerance = 1e-3;  ///< final bracket width on msm_beta
   int max_refinements = 40;
   bool estimate_alpha = false;  ///< also fit msm_alpha in [alpha_min, 1] (trajectory mode only)
   double alpha_min = 0.05;
@@ -58,16 +58,16 @@ struct DeformabilityConfig {
 struct DeformabilityResult {
   double msm_beta = 0;
   double msm_alpha = 1;
-  double msm_beta_std = 0;      ///< one standard deviation; +inf when not identifiable
+  double msm_beta_std = 0;          ///< one standard deviation; +inf when not identifiable
   double residual_correlation = 0;  ///< share of residual variance persisting per particle (icc)
   bool unique_minimum = false;
-  double error = 0;             ///< E at the estimate (eq. 15), length unit
-  double rms = 0;               ///< rms position residual at the estimate, length unit
-  long residual_count = 0;      ///< observed (frame, particle) pairs compared
+  double error = 0;         ///< E at the estimate (eq. 15), length unit
+  double rms = 0;           ///< rms position residual at the estimate, length unit
+  long residual_count = 0;  ///< observed (frame, particle) pairs compared
   int evaluations = 0;
   int frames_without_observations = 0;  ///< frames where no free particle was observed
   int unconverged_equilibria = 0;       ///< final mode: relaxations that hit their bound
-  int curve_count = 0;          ///< samples in the workspace curve, ascending msm_beta
+  int curve_count = 0;                  ///< samples in the workspace curve, ascending msm_beta
 };
 
 template <int Dim, typename Scalar>
@@ -75,18 +75,18 @@ struct DeformabilityWorkspace {
   using Vec = Eigen::Matrix<Scalar, Dim, 1>;
   MsmState<Dim, Scalar> state;
   int driven_capacity = 0;
-  int* target_ids = nullptr;     ///< [driven_capacity]
-  Vec* targets = nullptr;        ///< [driven_capacity]
-  Vec* held = nullptr;           ///< [driven_capacity] last target per driven window
-  std::uint8_t* window_active = nullptr;  ///< [driven_capacity]
-  Vec* previous = nullptr;       ///< [particle_count] equilibrium convergence check
+  int* target_ids = nullptr;                              ///< [driven_capacity]
+  Vec* targets = nullptr;                                 ///< [driven_capacity]
+  Vec* held = nullptr;                                    ///< [driven_capacity] last target per driven window
+  std::uint8_t* window_active = nullptr;                  ///< [driven_capacity]
+  Vec* previous = nullptr;                                ///< [particle_count] equilibrium convergence check
   Eigen::Matrix<double, Dim, 1>* residual_sum = nullptr;  ///< [particle_count] per-particle sums
-  double* residual_samples = nullptr;                      ///< [particle_count]
+  double* residual_samples = nullptr;                     ///< [particle_count]
   int curve_capacity = 0;
-  double* curve_beta = nullptr;  ///< [curve_capacity] E(beta) samples of the last estimate
-  double* curve_error = nullptr; ///< [curve_capacity]
+  double* curve_beta = nullptr;         ///< [curve_capacity] E(beta) samples of the last estimate
+  double* curve_error = nullptr;        ///< [curve_capacity]
   double* curve_sum_squares = nullptr;  ///< [curve_capacity] sum of squared residuals per sample
-  double* grid_error = nullptr;  ///< [grid_capacity] scratch: E on the uniform grid
+  double* grid_error = nullptr;         ///< [grid_capacity] scratch: E on the uniform grid
   int grid_capacity = 0;
 };
 
@@ -95,8 +95,8 @@ std::size_t deformability_workspace_size(const MsmModel<Dim, Scalar>& model, int
                                          const DeformabilityConfig& config) noexcept;
 
 template <int Dim, typename Scalar>
-[[nodiscard]] Status deformability_workspace_init(Arena& arena, const MsmModel<Dim, Scalar>& model,
-                                                  int driven_capacity, const DeformabilityConfig& config,
+[[nodiscard]] Status deformability_workspace_init(Arena& arena, const MsmModel<Dim, Scalar>& model, int driven_capacity,
+                                                  const DeformabilityConfig& config,
                                                   DeformabilityWorkspace<Dim, Scalar>& workspace) noexcept;
 
 /// Estimates msm_beta (and msm_alpha when asked) from `observations`. `base` supplies every
@@ -105,8 +105,7 @@ template <int Dim, typename Scalar>
 /// model or workspace, times not increasing, driven ids not drivable), no_free_particles,
 /// no_observations. A result with unconverged equilibria still returns ok; check the count.
 template <int Dim, typename Scalar>
-[[nodiscard]] Status estimate_deformability(const MsmModel<Dim, Scalar>& model,
-                                            const MsmParams<Dim, Scalar>& base,
+[[nodiscard]] Status estimate_deformability(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>& base,
                                             const ObservationSequence<Dim, Scalar>& observations,
                                             const DeformabilityConfig& config,
                                             DeformabilityWorkspace<Dim, Scalar>& workspace,

@@ -185,7 +185,8 @@ struct GraspGuardConfig {
 
   // --- status words: set bits in the mask are faults -----------------------------------------------
   std::uint32_t gripper_fault_mask = 0xffffffffu;
-  /// ATI NETCANOEM status bits 1-7, 11, 12 (HARDWARE.md 1.2); map other sensors' words to them.
+  /// ATI NETCANOEM status bits 1-7, 11, 12 (docs/drivers/socketcan.md); map other sensors'
+  /// words to them.
   std::uint32_t wrench_fault_mask = 0x18feu;
   std::uint32_t camera_fault_mask = 0xffffffffu;
 
@@ -227,8 +228,8 @@ struct GraspGuardConfig {
   /// NaN: 2 x max_strain x (1 + stop_overshoot) x the object's extent along the axis (twice
   /// the stop threshold under uniform compression), at most half the extent.
   double prediction_max_closure_m = kNaN;
-  int relax_max_iterations = 3000;     ///< >= 1 msm_steps per quasi-static relaxation
-  double relax_tolerance = 1e-6;       ///< converged when no particle moves more (x spacing)
+  int relax_max_iterations = 3000;  ///< >= 1 msm_steps per quasi-static relaxation
+  double relax_tolerance = 1e-6;    ///< converged when no particle moves more (x spacing)
 };
 
 /// The object and how the jaws meet it (init only; arrays are read during init).
@@ -262,9 +263,9 @@ struct GripperSample {
 
 struct WrenchSample {
   double stamp_s = GraspGuardConfig::kNaN;
-  double wrench[6] = {GraspGuardConfig::kNaN, GraspGuardConfig::kNaN, GraspGuardConfig::kNaN,
-                      GraspGuardConfig::kNaN, GraspGuardConfig::kNaN, GraspGuardConfig::kNaN};  ///< Fx Fy Fz N, Tx Ty Tz N m
-  std::uint32_t status_bits = 0;  ///< e.g. the ATI status word
+  double wrench[6] = {GraspGuardConfig::kNaN, GraspGuardConfig::kNaN, GraspGuardConfig::kNaN, GraspGuardConfig::kNaN,
+                      GraspGuardConfig::kNaN, GraspGuardConfig::kNaN};  ///< Fx Fy Fz N, Tx Ty Tz N m
+  std::uint32_t status_bits = 0;                                        ///< e.g. the ATI status word
   bool valid = false;
   bool bus_off = false;
   bool timeout = false;
@@ -300,26 +301,26 @@ struct GraspGuardOutput {
   GraspVerdict verdict = GraspVerdict::stop;
   GuardReason reason = GuardReason::not_configured;  ///< dominant reason; none when ok
   StopAction stop_action = StopAction::freeze;       ///< what stop means this cycle
-  std::uint32_t reasons = 0;       ///< bit (1u << reason) per active reason, informational ones too
-  std::uint8_t fault_sources = 0;  ///< bit (1u << source) per source with an active fault
+  std::uint32_t reasons = 0;                         ///< bit (1u << reason) per active reason, informational ones too
+  std::uint8_t fault_sources = 0;                    ///< bit (1u << source) per source with an active fault
   bool in_contact = false;
-  bool slip = false;               ///< slip cue active this cycle
+  bool slip = false;  ///< slip cue active this cycle
   double contact_width_m = GraspGuardConfig::kNaN;
-  double closure_m = 0;            ///< contact width - width, >= 0 (0 before contact)
-  double force_n = GraspGuardConfig::kNaN;  ///< grip force used this cycle
-  double strain = GraspGuardConfig::kNaN;   ///< measured strain used this cycle
-  double allowed_force_n = GraspGuardConfig::kNaN;  ///< nominal, raised by slip, <= max_force_n
-  double beta_low = 0, beta_high = 1;        ///< msm_beta interval of the prediction
-  double predicted_strain = GraspGuardConfig::kNaN;  ///< at the current closure, worst over the interval
-  double strain_safe_closure_m = 0;   ///< largest closure keeping the predicted strain <= max_strain
+  double closure_m = 0;                                  ///< contact width - width, >= 0 (0 before contact)
+  double force_n = GraspGuardConfig::kNaN;               ///< grip force used this cycle
+  double strain = GraspGuardConfig::kNaN;                ///< measured strain used this cycle
+  double allowed_force_n = GraspGuardConfig::kNaN;       ///< nominal, raised by slip, <= max_force_n
+  double beta_low = 0, beta_high = 1;                    ///< msm_beta interval of the prediction
+  double predicted_strain = GraspGuardConfig::kNaN;      ///< at the current closure, worst over the interval
+  double strain_safe_closure_m = 0;                      ///< largest closure keeping the predicted strain <= max_strain
   double force_safe_closure_m = GraspGuardConfig::kInf;  ///< where the predicted force reaches allowed_force_n
-  double safe_closure_m = 0;          ///< min of the above and max_indentation_m
-  double safe_width_m = GraspGuardConfig::kNaN;  ///< contact width - safe_closure_m (NaN before contact)
+  double safe_closure_m = 0;                             ///< min of the above and max_indentation_m
+  double safe_width_m = GraspGuardConfig::kNaN;          ///< contact width - safe_closure_m (NaN before contact)
   /// Grip force the force model predicts at safe_closure_m: the largest force predicted safe
   /// (allowed_force_n itself when the force bounds the closure). NaN without a force model.
   double predicted_force_n = GraspGuardConfig::kNaN;
   double stiffness_n_per_m = GraspGuardConfig::kNaN;  ///< slope used by the force model
-  double slip_force_n = 0;            ///< magnitude of the high-passed wrist force
+  double slip_force_n = 0;                            ///< magnitude of the high-passed wrist force
 };
 
 /// Monotonic counters: every refused or stale input is counted.
@@ -328,7 +329,7 @@ struct GraspGuardCounters {
   std::uint32_t limit_cycles = 0;
   std::uint32_t stop_cycles = 0;
   std::uint32_t slip_cycles = 0;
-  std::uint32_t refused[kGuardSourceCount] = {};      ///< cycles a source's input was refused (nan, invalid, fault)
+  std::uint32_t refused[kGuardSourceCount] = {};       ///< cycles a source's input was refused (nan, invalid, fault)
   std::uint32_t stale_cycles[kGuardSourceCount] = {};  ///< cycles a source was stale
 };
 
@@ -384,14 +385,14 @@ template <int Dim, typename Scalar>
 struct GraspGuard {
   using Vec = Eigen::Matrix<Scalar, Dim, 1>;
   using MatD = Eigen::Matrix<double, Dim, Dim>;
-  GraspGuardConfig config;       ///< validated copy (nominal_force_n resolved)
+  GraspGuardConfig config;  ///< validated copy (nominal_force_n resolved)
   int particle_count = 0;
   int cluster_count = 0;
   Vec squeeze_axis = Vec::Zero();  ///< unit
   double extent_m = 0;             ///< the model's extent along the axis (extreme particle centres)
   int beta_points = 0;
   int closure_points = 0;
-  double closure_step_m = 0;       ///< table closure k x closure_step_m, k = 0..closure_points
+  double closure_step_m = 0;  ///< table closure k x closure_step_m, k = 0..closure_points
   /// [beta_points x (closure_points + 1)], row j = msm_beta j / (beta_points - 1): predicted
   /// largest cluster strain at each tabulated closure.
   double* strain_table = nullptr;
@@ -458,7 +459,8 @@ struct GraspStrainMeasurement {
 /// Returns ok, no_observations (nothing measured; strain NaN), invalid_argument (positions null
 /// or the model is not the guard's) or not_initialized. Real-time safe, O(memberships).
 template <int Dim, typename Scalar>
-[[nodiscard]] Status grasp_guard_measure_strain(const MsmModel<Dim, Scalar>& model, const GraspGuard<Dim, Scalar>& guard,
+[[nodiscard]] Status grasp_guard_measure_strain(const MsmModel<Dim, Scalar>& model,
+                                                const GraspGuard<Dim, Scalar>& guard,
                                                 const Eigen::Matrix<Scalar, Dim, 1>* positions,
                                                 GraspStrainMeasurement& measurement) noexcept;
 

@@ -36,7 +36,7 @@ struct MsmParams {
   Scalar msm_beta = 0;   ///< [0, 1]: 0 rigid clusters, 1 fully affine (deformable)
   /// Optional per-cluster msm_beta ([cluster_count], caller memory); overrides msm_beta.
   const Scalar* cluster_beta = nullptr;
-  Vec gravity = Vec::Zero();  ///< body acceleration, length unit / s^2
+  Vec gravity = Vec::Zero();    ///< body acceleration, length unit / s^2
   Scalar velocity_damping = 0;  ///< 1/s: v' *= max(0, 1 - velocity_damping * dt)
   /// Plasticity: off while plastic_creep == 0. Yield and max are Frobenius norms of strain.
   Scalar plastic_yield = 0;
@@ -61,8 +61,7 @@ struct MsmParams {
 
 /// Per-cluster rotation kept between steps: the 2D matrix or the 3D quaternion warm start.
 template <int Dim, typename Scalar>
-using ClusterRotation = std::conditional_t<Dim == 2, Eigen::Matrix<Scalar, 2, 2>,
-                                           Eigen::Quaternion<Scalar>>;
+using ClusterRotation = std::conditional_t<Dim == 2, Eigen::Matrix<Scalar, 2, 2>, Eigen::Quaternion<Scalar>>;
 
 template <int Dim, typename Scalar>
 struct MsmState {
@@ -73,13 +72,13 @@ struct MsmState {
   Vec* predicted = nullptr;  ///< [particle_count] scratch
   /// Step scratch: per particle [m x q^T | m x] and per cluster the goal map [G | b] with
   /// goal = G r + b (both relative to the origins in MsmModel::rest_origin and the step's mean).
-  Eigen::Matrix<Scalar, Dim, Dim + 1>* moment = nullptr;          ///< [particle_count]
+  Eigen::Matrix<Scalar, Dim, Dim + 1>* moment = nullptr;            ///< [particle_count]
   Eigen::Matrix<Scalar, Dim, Dim + 1>* cluster_goal_map = nullptr;  ///< [cluster_count]
-  std::uint8_t* driven_now = nullptr;  ///< [particle_count] 1 while driven in the last step
+  std::uint8_t* driven_now = nullptr;                ///< [particle_count] 1 while driven in the last step
   ClusterRotation<Dim, Scalar>* rotation = nullptr;  ///< [cluster_count]
-  Mat* plastic = nullptr;    ///< [cluster_count] S_p, identity when no plastic set
-  Mat* relaxed = nullptr;    ///< [cluster_count] relaxed strain V (identity at rest)
-  double time_s = 0;         ///< sum of accepted dt
+  Mat* plastic = nullptr;                            ///< [cluster_count] S_p, identity when no plastic set
+  Mat* relaxed = nullptr;                            ///< [cluster_count] relaxed strain V (identity at rest)
+  double time_s = 0;                                 ///< sum of accepted dt
   std::uint32_t steps = 0;
   std::uint32_t dropped_targets = 0;  ///< driven targets ignored for being non-finite
   std::uint32_t rejected_steps = 0;   ///< steps refused (bad dt, non-finite force)
@@ -120,9 +119,7 @@ void msm_state_reset(const MsmModel<Dim, Scalar>& model, MsmState<Dim, Scalar>& 
 /// dropped (the step still ran), or invalid_argument / non_finite_input when the step was
 /// rejected (state unchanged), or not_initialized.
 template <int Dim, typename Scalar>
-[[nodiscard]] Status msm_step(const MsmModel<Dim, Scalar>& model,
-                              const MsmParams<Dim, Scalar>& params,
-                              const MsmStepInput<Dim, Scalar>& input,
-                              MsmState<Dim, Scalar>& state) noexcept;
+[[nodiscard]] Status msm_step(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>& params,
+                              const MsmStepInput<Dim, Scalar>& input, MsmState<Dim, Scalar>& state) noexcept;
 
 }  // namespace pliant

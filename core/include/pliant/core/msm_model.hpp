@@ -29,9 +29,9 @@
 namespace pliant {
 
 enum class ClusterLayout : std::uint8_t {
-  radius,     ///< one cluster per particle: all particles within radius_factor x median NN distance
-  k_nearest,  ///< one cluster per particle: itself and its k nearest neighbours
-  grid_blocks ///< every block_cols x block_rows (x block_layers) window of a particle grid, stride 1
+  radius,      ///< one cluster per particle: all particles within radius_factor x median NN distance
+  k_nearest,   ///< one cluster per particle: itself and its k nearest neighbours
+  grid_blocks  ///< every block_cols x block_rows (x block_layers) window of a particle grid, stride 1
 };
 
 struct ClusterConfig {
@@ -47,11 +47,11 @@ struct ClusterConfig {
 template <int Dim, typename Scalar>
 struct MsmModelConfig {
   static_assert(Dim == 2 || Dim == 3, "MSM is defined in 2D and 3D");
-  int particle_count = 0;                 ///< N >= 1
-  const Scalar* rest_positions = nullptr; ///< N * Dim, particle-major
-  const Scalar* masses = nullptr;         ///< N, each finite > 0; nullptr = 1 for all
-  const std::uint8_t* fixed = nullptr;    ///< N flags, 1 = pinned at rest; nullptr = none
-  const int* drivable_ids = nullptr;      ///< particles that may be driven (the tool contact)
+  int particle_count = 0;                  ///< N >= 1
+  const Scalar* rest_positions = nullptr;  ///< N * Dim, particle-major
+  const Scalar* masses = nullptr;          ///< N, each finite > 0; nullptr = 1 for all
+  const std::uint8_t* fixed = nullptr;     ///< N flags, 1 = pinned at rest; nullptr = none
+  const int* drivable_ids = nullptr;       ///< particles that may be driven (the tool contact)
   int drivable_count = 0;
   /// The paper makes the manipulated particle heavier so it pulls cluster centroids toward the
   /// tool. 1 (default) uses masses as given; the factor multiplies drivable particles' masses.
@@ -62,7 +62,7 @@ struct MsmModelConfig {
 /// Clusters per batch of the step's vectorised cluster pass (see MsmModel::cluster_lanes).
 inline constexpr int kMsmClusterBatch = 8;
 template <int Dim>
-inline constexpr int kMsmClusterLaneFields = Dim + Dim * Dim + 1;
+inline constexpr int kMsmClusterLaneFields = Dim + Dim* Dim + 1;
 
 template <int Dim, typename Scalar>
 struct MsmModel {
@@ -71,12 +71,12 @@ struct MsmModel {
 
   int particle_count = 0;
   int cluster_count = 0;
-  int membership_count = 0;      ///< total cluster members over all clusters
-  Scalar spacing = 0;            ///< median nearest-neighbour distance of the rest shape
-  Vec* rest = nullptr;           ///< [particle_count]
-  Scalar* mass = nullptr;        ///< [particle_count], drivable ones scaled
-  std::uint8_t* fixed = nullptr; ///< [particle_count]
-  std::uint8_t* drivable = nullptr;     ///< [particle_count]
+  int membership_count = 0;                 ///< total cluster members over all clusters
+  Scalar spacing = 0;                       ///< median nearest-neighbour distance of the rest shape
+  Vec* rest = nullptr;                      ///< [particle_count]
+  Scalar* mass = nullptr;                   ///< [particle_count], drivable ones scaled
+  std::uint8_t* fixed = nullptr;            ///< [particle_count]
+  std::uint8_t* drivable = nullptr;         ///< [particle_count]
   Scalar* inverse_cluster_count = nullptr;  ///< [particle_count] 1/(clusters holding i), 0 if none
   std::int32_t* cluster_begin = nullptr;    ///< [cluster_count + 1] offsets into members
   std::int32_t* members = nullptr;          ///< [membership_count] particle ids
@@ -91,7 +91,7 @@ struct MsmModel {
   /// The same two lists as byte offsets into the step's per-particle moments and per-cluster
   /// goal maps (members[k] and particle_clusters[k] times sizeof(Eigen::Matrix<Scalar, Dim,
   /// Dim + 1>)), which spares the step's gathers an index multiplication per membership.
-  std::int32_t* member_byte_offset = nullptr;          ///< [membership_count]
+  std::int32_t* member_byte_offset = nullptr;            ///< [membership_count]
   std::int32_t* particle_cluster_byte_offset = nullptr;  ///< [membership_count]
   /// Per-cluster constants of the step in batches of kMsmClusterBatch clusters, lane-wise
   /// (structure of arrays) for its vectorised cluster pass: per batch b, field f, lane l at

@@ -25,7 +25,7 @@ struct OnlineDeformabilityConfig {
 
 struct OnlineDeformabilityEstimate {
   double msm_beta = 0;
-  double msm_beta_std = 0;   ///< +inf until the curve has positive curvature
+  double msm_beta_std = 0;  ///< +inf until the curve has positive curvature
   bool unique_minimum = false;
   double rms = 0;            ///< rms residual of the best candidate, length unit
   std::uint32_t frames = 0;  ///< frames accepted so far
@@ -34,10 +34,10 @@ struct OnlineDeformabilityEstimate {
 template <int Dim, typename Scalar>
 struct OnlineDeformability {
   int candidates = 0;
-  MsmParams<Dim, Scalar> params;   ///< base parameters; msm_beta is set per candidate
+  MsmParams<Dim, Scalar> params;            ///< base parameters; msm_beta is set per candidate
   MsmState<Dim, Scalar>* states = nullptr;  ///< [candidates]
-  double* sum_squares = nullptr;   ///< [candidates], forgetting applied
-  double residual_count = 0;       ///< scalar residuals, forgetting applied
+  double* sum_squares = nullptr;            ///< [candidates], forgetting applied
+  double residual_count = 0;                ///< scalar residuals, forgetting applied
   double forgetting = 1;
   std::uint32_t frames = 0;
   std::uint32_t rejected_frames = 0;  ///< bad dt, size mismatch

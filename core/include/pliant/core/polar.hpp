@@ -33,7 +33,8 @@ inline bool extract_rotation(const Eigen::Matrix<Scalar, 2, 2>& a, Eigen::Matrix
   const Scalar length_squared = cos_part * cos_part + sin_part * sin_part;
   const Scalar epsilon = std::numeric_limits<Scalar>::epsilon();
   // Also false for NaN: then, or with no rotational information, keep the previous rotation.
-  if (!(length_squared > epsilon * epsilon * a.squaredNorm()) || !(length_squared <= std::numeric_limits<Scalar>::max())) {
+  if (!(length_squared > epsilon * epsilon * a.squaredNorm()) ||
+      !(length_squared <= std::numeric_limits<Scalar>::max())) {
     return a.allFinite();
   }
   const Scalar inverse_length = Scalar(1) / std::sqrt(length_squared);
@@ -65,8 +66,7 @@ constexpr Scalar simulation_rotation_tolerance() noexcept {
 /// 3D: `orientation` is the warm start and the result (unit quaternion).
 template <typename Scalar>
 bool extract_rotation(const Eigen::Matrix<Scalar, 3, 3>& a, Eigen::Quaternion<Scalar>& orientation,
-                      int max_iterations = 24,
-                      Scalar step_tolerance = rotation_step_tolerance<Scalar>()) noexcept;
+                      int max_iterations = 24, Scalar step_tolerance = rotation_step_tolerance<Scalar>()) noexcept;
 
 #if defined(__GNUC__)
 #define PLIANT_INLINE inline __attribute__((always_inline))
@@ -123,7 +123,7 @@ template <typename Scalar>
 PLIANT_INLINE RotationTerms<Scalar> rotation_terms(const Scalar* r, const Scalar* a) noexcept {
   // m[i][j] = (R^T A)(i, j) = column i of R . column j of A (written out: no loops, so that
   // callers' loops over clusters stay innermost for the vectoriser).
-#define PLIANT_RTA(i, j) (r[(i) * 3] * a[(j) * 3] + r[(i) * 3 + 1] * a[(j) * 3 + 1] + r[(i) * 3 + 2] * a[(j) * 3 + 2])
+#define PLIANT_RTA(i, j) (r[(i)*3] * a[(j)*3] + r[(i)*3 + 1] * a[(j)*3 + 1] + r[(i)*3 + 2] * a[(j)*3 + 2])
   const Scalar m[3][3] = {{PLIANT_RTA(0, 0), PLIANT_RTA(0, 1), PLIANT_RTA(0, 2)},
                           {PLIANT_RTA(1, 0), PLIANT_RTA(1, 1), PLIANT_RTA(1, 2)},
                           {PLIANT_RTA(2, 0), PLIANT_RTA(2, 1), PLIANT_RTA(2, 2)}};
@@ -187,7 +187,7 @@ inline bool extract_rotation(const Eigen::Matrix<Scalar, 3, 3>& a, Eigen::Quater
     return false;
   }
   const Scalar length_squared = orientation.w() * orientation.w() + orientation.x() * orientation.x() +
-                                 orientation.y() * orientation.y() + orientation.z() * orientation.z();
+                                orientation.y() * orientation.y() + orientation.z() * orientation.z();
   if (!(std::abs(length_squared - Scalar(1)) <= Scalar(64) * epsilon)) {
     if (!std::isfinite(length_squared) || length_squared < Scalar(0.25)) {
       orientation.setIdentity();

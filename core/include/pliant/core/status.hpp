@@ -12,18 +12,18 @@
 
 namespace pliant {
 
-enum class [[nodiscard]] Status : std::uint8_t {
-  ok = 0,
-  invalid_argument,        ///< a size, index or option is out of its documented range
-  capacity_exceeded,       ///< the caller's memory block is smaller than *_workspace_size()
-  invalid_mass,            ///< a particle mass is not finite and > 0
-  non_finite_input,        ///< NaN or infinity in positions, targets, forces or time step
-  duplicate_rest_positions,///< two particles share a rest position (no spacing to build on)
-  degenerate_cluster,      ///< a cluster has too few members to define a rotation
-  no_free_particles,       ///< every particle is fixed or driven: nothing to simulate or fit
-  no_observations,         ///< no usable observation of a free particle
-  not_converged,           ///< an iteration hit its bound; the result is the last iterate
-  not_initialized,         ///< the object was used before a successful init
+enum class [[nodiscard]] Status : std::uint8_t{
+    ok = 0,
+    invalid_argument,          ///< a size, index or option is out of its documented range
+    capacity_exceeded,         ///< the caller's memory block is smaller than *_workspace_size()
+    invalid_mass,              ///< a particle mass is not finite and > 0
+    non_finite_input,          ///< NaN or infinity in positions, targets, forces or time step
+    duplicate_rest_positions,  ///< two particles share a rest position (no spacing to build on)
+    degenerate_cluster,        ///< a cluster has too few members to define a rotation
+    no_free_particles,         ///< every particle is fixed or driven: nothing to simulate or fit
+    no_observations,           ///< no usable observation of a free particle
+    not_converged,             ///< an iteration hit its bound; the result is the last iterate
+    not_initialized,           ///< the object was used before a successful init
 };
 
 /// Short, stable, human-readable name of a status ("ok", "invalid_mass", ...).
@@ -43,9 +43,9 @@ void assert_failed(const char* expression, const char* file, int line) noexcept;
 
 }  // namespace pliant
 
-#define PLIANT_ASSERT(expression)                                        \
-  do {                                                                   \
-    if (!(expression)) {                                                 \
-      ::pliant::detail::assert_failed(#expression, __FILE__, __LINE__);  \
-    }                                                                    \
+#define PLIANT_ASSERT(expression)                                       \
+  do {                                                                  \
+    if (!(expression)) {                                                \
+      ::pliant::detail::assert_failed(#expression, __FILE__, __LINE__); \
+    }                                                                   \
   } while (false)

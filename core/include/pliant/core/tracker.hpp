@@ -55,7 +55,7 @@
 namespace pliant {
 
 struct TrackerConfig {
-  double tukey_c = 4.685;          ///< Tukey cutoff in robust-scale units, > 0 (95 % Gaussian efficiency)
+  double tukey_c = 4.685;  ///< Tukey cutoff in robust-scale units, > 0 (95 % Gaussian efficiency)
   /// Floor of the robust residual scale, length unit, >= 0: set it to the observation noise sd
   /// per axis. Below it nothing is an outlier, so it also keeps noise-free data with a model
   /// error from being rejected. 0 uses 0.02 x the model's rest spacing (the median
@@ -76,8 +76,8 @@ enum class TrackStatus : std::uint8_t {
 template <int Dim, typename Scalar>
 struct TrackerFrame {
   using Vec = Eigen::Matrix<Scalar, Dim, 1>;
-  Scalar dt = 0;                          ///< s since the previous frame, finite > 0
-  MsmDrivenTargets<Dim, Scalar> driven;   ///< tool contact targets this frame (may be empty)
+  Scalar dt = 0;                         ///< s since the previous frame, finite > 0
+  MsmDrivenTargets<Dim, Scalar> driven;  ///< tool contact targets this frame (may be empty)
   /// [particle_count] observed positions; a non-finite entry is unobserved. nullptr: no
   /// observation this frame (the frame is pure prediction).
   const Vec* observed = nullptr;
@@ -100,24 +100,24 @@ struct TrackerCounters {
 template <int Dim, typename Scalar>
 struct Tracker {
   using Vec = Eigen::Matrix<Scalar, Dim, 1>;
-  TrackerConfig config;              ///< validated copy
+  TrackerConfig config;  ///< validated copy
   /// The prior's parameters. msm_beta may be changed between frames (e.g. fed back from the
   /// online estimate); cluster_beta, if set, must outlive the tracker.
   MsmParams<Dim, Scalar> params;
-  MsmState<Dim, Scalar> state;       ///< state.position: the tracked positions [particle_count]
-  Scalar* weight = nullptr;          ///< [particle_count] last frame's weight (0: not used)
-  TrackStatus* status = nullptr;     ///< [particle_count]
+  MsmState<Dim, Scalar> state;                ///< state.position: the tracked positions [particle_count]
+  Scalar* weight = nullptr;                   ///< [particle_count] last frame's weight (0: not used)
+  TrackStatus* status = nullptr;              ///< [particle_count]
   std::int32_t* unobserved_frames = nullptr;  ///< [particle_count] consecutive frames without use
-  Vec* residual = nullptr;           ///< [particle_count] last frame's r_i (zero: no usable observation)
-  Vec* coherent = nullptr;           ///< [particle_count] last frame's m_i
-  Vec* cluster_residual = nullptr;   ///< [cluster_count] median residual (NaN: no usable member)
+  Vec* residual = nullptr;                    ///< [particle_count] last frame's r_i (zero: no usable observation)
+  Vec* coherent = nullptr;                    ///< [particle_count] last frame's m_i
+  Vec* cluster_residual = nullptr;            ///< [cluster_count] median residual (NaN: no usable member)
   /// [particle_count] scratch: 1 usable observation this frame, 2 held (fixed or driven: known
   /// exactly, a zero residual for the cluster medians), 0 neither.
   std::uint8_t* usable = nullptr;
-  Scalar* scratch = nullptr;         ///< [max(particle_count, largest cluster)] median scratch
-  Vec* goal = nullptr;               ///< [particle_count] projection scratch
-  Scalar residual_scale = 0;         ///< last frame's robust scale s (per axis), length unit
-  std::uint32_t frame_index = 0;     ///< frames accepted since init or reset
+  Scalar* scratch = nullptr;      ///< [max(particle_count, largest cluster)] median scratch
+  Vec* goal = nullptr;            ///< [particle_count] projection scratch
+  Scalar residual_scale = 0;      ///< last frame's robust scale s (per axis), length unit
+  std::uint32_t frame_index = 0;  ///< frames accepted since init or reset
   TrackerCounters counters;
   bool initialized() const noexcept { return weight != nullptr; }
 };

@@ -62,7 +62,7 @@ struct ModbusEmulator::Impl {
   int header_length = 0;
   int listen_fd = -1;
   int clients[kMaxClients] = {-1, -1, -1, -1, -1, -1, -1, -1};  // tcp; closed by the server thread only
-  int master_fd = -1;  // rtu_pty
+  int master_fd = -1;                                           // rtu_pty
   int slave_hold_fd = -1;
   std::string path;
   std::uint16_t port = 0;
@@ -264,7 +264,8 @@ void ModbusEmulator::Impl::sync_registers() {
   }
   double w[6];
   for (int i = 0; i < 6; ++i) w[i] = wrench[i];
-  if (config.ft_grip_force_axis >= 0 && config.ft_grip_force_axis < 6) w[config.ft_grip_force_axis] += model.grip_force_n();
+  if (config.ft_grip_force_axis >= 0 && config.ft_grip_force_axis < 6)
+    w[config.ft_grip_force_axis] += model.grip_force_n();
   ft300::wrench_to_registers(w, map->tab_registers + (ft300::kWrenchRegister - kHoldingStart));
 }
 
@@ -317,8 +318,10 @@ void ModbusEmulator::Impl::send_corrupted(int fd, const std::uint8_t* q, int len
     for (int i = 0; i < count; ++i) {
       const int a = address + i;
       std::uint16_t v = 0;
-      if (fn == 0x04 && a >= kInputStart && a < kInputStart + kInputCount) v = map->tab_input_registers[a - kInputStart];
-      if (fn == 0x03 && a >= kHoldingStart && a < kHoldingStart + kHoldingCount) v = map->tab_registers[a - kHoldingStart];
+      if (fn == 0x04 && a >= kInputStart && a < kInputStart + kInputCount)
+        v = map->tab_input_registers[a - kInputStart];
+      if (fn == 0x03 && a >= kHoldingStart && a < kHoldingStart + kHoldingCount)
+        v = map->tab_registers[a - kHoldingStart];
       put_be16(pdu + pdu_size, v);
       pdu_size += 2;
     }
@@ -399,7 +402,8 @@ bool ModbusEmulator::start(std::string* error) {
     if (error != nullptr) *error = "already started";
     return false;
   }
-  if (m.config.slave_id < 1 || m.config.slave_id > 247 || r2f::validate(m.config.gripper.scaling) != hal::HalStatus::ok) {
+  if (m.config.slave_id < 1 || m.config.slave_id > 247 ||
+      r2f::validate(m.config.gripper.scaling) != hal::HalStatus::ok) {
     if (error != nullptr) *error = "invalid configuration";
     return false;
   }

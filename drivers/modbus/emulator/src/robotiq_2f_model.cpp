@@ -47,8 +47,8 @@ void Robotiq2fModel::write_command(const r2f::Command& command) noexcept {
     return;
   }
   const bool rising = (previous.action & r2f::kActionGoTo) == 0;
-  const bool changed = previous.position != command.position || previous.speed != command.speed ||
-                       previous.force != command.force;
+  const bool changed =
+      previous.position != command.position || previous.speed != command.speed || previous.force != command.force;
   if (rising || changed) {
     moving_ = true;
     gobj_ = r2f::kObjMoving;
@@ -108,8 +108,8 @@ void Robotiq2fModel::step(double dt_s) noexcept {
 double Robotiq2fModel::grip_force_n() const noexcept {
   if (!has_object() || width_m_ > config_.object_width_m) return 0;
   if (std::isinf(config_.object_stiffness_n_per_m)) {
-    const bool holding = gsta_ == r2f::kStaActivated && (command_.action & r2f::kActionGoTo) != 0 &&
-                         gobj_ == r2f::kObjContactClosing;
+    const bool holding =
+        gsta_ == r2f::kStaActivated && (command_.action & r2f::kActionGoTo) != 0 && gobj_ == r2f::kObjContactClosing;
     return holding ? r2f::byte_to_force(command_.force, config_.scaling) : 0.0;
   }
   return config_.object_stiffness_n_per_m * (config_.object_width_m - width_m_);

@@ -9,7 +9,9 @@ namespace pliant::drivers::socketcan {
 AtiNetCanEmulator::AtiNetCanEmulator(CanTransport& link, const AtiEmulatorConfig& config) noexcept
     : link_(&link), config_(config), base_id_(static_cast<std::uint8_t>(config.base_id & ati::kMaxBaseId)) {}
 
-void AtiNetCanEmulator::set_gauges(const std::int16_t gauges[6]) noexcept { std::memcpy(gauges_, gauges, sizeof gauges_); }
+void AtiNetCanEmulator::set_gauges(const std::int16_t gauges[6]) noexcept {
+  std::memcpy(gauges_, gauges, sizeof gauges_);
+}
 
 CanIo AtiNetCanEmulator::send_raw(const CanFrame& frame) noexcept {
   const CanIo io = link_->send(frame);

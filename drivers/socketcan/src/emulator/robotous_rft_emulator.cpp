@@ -109,7 +109,8 @@ void RobotousRftEmulator::handle(const CanFrame& frame) noexcept {
 
 void RobotousRftEmulator::send_packet(std::uint8_t command) noexcept {
   std::int16_t out[6];
-  for (int i = 0; i < 6; ++i) out[i] = saturate(static_cast<std::int32_t>(raw_[i]) - static_cast<std::int32_t>(bias_[i]));
+  for (int i = 0; i < 6; ++i)
+    out[i] = saturate(static_cast<std::int32_t>(raw_[i]) - static_cast<std::int32_t>(bias_[i]));
   std::uint8_t packet[rft::kPacketSize];
   rft::encode_ft_packet(command, out, overload_, packet);
   CanFrame first, second;

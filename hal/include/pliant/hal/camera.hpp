@@ -41,8 +41,8 @@ struct DepthFrame {
   SampleHeader header;
   int width = 0;
   int height = 0;
-  int stride_bytes = 0;         ///< >= 2 * width
-  double depth_scale_m = 1e-3;  ///< metres per unit (1e-3: millimetres, OpenNI2's DEPTH_1_MM)
+  int stride_bytes = 0;                 ///< >= 2 * width
+  double depth_scale_m = 1e-3;          ///< metres per unit (1e-3: millimetres, OpenNI2's DEPTH_1_MM)
   const std::uint16_t* data = nullptr;  ///< depth along the optical axis; 0 = no measurement
   /// Pinhole intrinsics, px; NaN when the device does not report them.
   double fx = std::numeric_limits<double>::quiet_NaN();
@@ -55,7 +55,7 @@ struct DepthFrame {
 /// (world) frame, m. Particle i of every frame is the same material point.
 struct ParticleFrame {
   SampleHeader header;
-  int dimension = 3;       ///< 2 or 3
+  int dimension = 3;  ///< 2 or 3
   int particle_count = 0;
   /// [particle_count * dimension], particle-major; a particle with any non-finite coordinate
   /// is unobserved in this frame.

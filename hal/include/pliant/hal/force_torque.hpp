@@ -1,5 +1,6 @@
 // pliant hal: a six-axis force/torque sensor (e.g. ATI F/T over a NETCANOEM CAN board,
-// Robotous RFT, Robotiq FT 300; HARDWARE.md sections 1 and 2.2).
+// Robotous RFT, Robotiq FT 300; device facts in docs/hal.md, docs/drivers/socketcan.md and
+// docs/drivers/modbus.md).
 //
 // Units and frame: wrench = Fx Fy Fz (N), Tx Ty Tz (N m) in the sensor's own frame, tared as
 //   the driver was configured (the mocks have no bias).

@@ -1,5 +1,5 @@
-// pliant hal: a parallel two-jaw gripper (e.g. Robotiq 2F-85/140 over Modbus, see
-// HARDWARE.md section 2.1).
+// pliant hal: a parallel two-jaw gripper (e.g. Robotiq 2F-85/140 over Modbus; device facts and
+// their sources in docs/hal.md and docs/drivers/modbus.md, "Device facts we rely on").
 //
 // Units: width_m is the pad-to-pad opening (m), speeds m/s, forces N, current A.
 // Reading: the latest state (width, grip force or motor current, status bits), stamped on the
@@ -35,7 +35,7 @@ inline constexpr std::uint32_t kGripperFaultCodeMask = 0xffu << kGripperFaultCod
 /// The bits that mean a fault: a non-zero fault code. Use as GraspGuardConfig::gripper_fault_mask.
 inline constexpr std::uint32_t kGripperFaultMask = kGripperFaultCodeMask;
 
-/// Fault codes (Robotiq gFLT values, HARDWARE.md 2.1) for bits 8-15.
+/// Fault codes (Robotiq gFLT values, docs/drivers/modbus.md) for bits 8-15.
 inline constexpr std::uint8_t kGripperFaultOverTemperature = 0x08;
 inline constexpr std::uint8_t kGripperFaultUnderVoltage = 0x0a;
 inline constexpr std::uint8_t kGripperFaultInternal = 0x0c;
@@ -47,9 +47,9 @@ constexpr std::uint8_t gripper_fault_code(std::uint32_t status_bits) noexcept {
 
 struct GripperReading {
   SampleHeader header;
-  double width_m = std::numeric_limits<double>::quiet_NaN();    ///< pad-to-pad opening
-  double force_n = std::numeric_limits<double>::quiet_NaN();    ///< grip force (NaN if not sensed)
-  double current_a = std::numeric_limits<double>::quiet_NaN();  ///< motor current (NaN if not sensed)
+  double width_m = std::numeric_limits<double>::quiet_NaN();         ///< pad-to-pad opening
+  double force_n = std::numeric_limits<double>::quiet_NaN();         ///< grip force (NaN if not sensed)
+  double current_a = std::numeric_limits<double>::quiet_NaN();       ///< motor current (NaN if not sensed)
   double target_width_m = std::numeric_limits<double>::quiet_NaN();  ///< the width being moved to
 };
 
@@ -57,16 +57,16 @@ enum class GripperCommandKind : std::uint8_t { move, stop, open };
 
 struct GripperCommand {
   GripperCommandKind kind = GripperCommandKind::stop;
-  double width_m = std::numeric_limits<double>::quiet_NaN();  ///< move: target opening
+  double width_m = std::numeric_limits<double>::quiet_NaN();        ///< move: target opening
   double speed_m_per_s = std::numeric_limits<double>::quiet_NaN();  ///< move, open
-  double force_n = std::numeric_limits<double>::quiet_NaN();  ///< move: stop closing at this grip force
+  double force_n = std::numeric_limits<double>::quiet_NaN();        ///< move: stop closing at this grip force
 };
 
 struct GripperLimits {
   double min_width_m = 0;
   double max_width_m = 0.085;
   double max_speed_m_per_s = 0.15;
-  double min_force_n = 0;    ///< a Robotiq's force byte 0 is not zero force (HARDWARE.md 2.1)
+  double min_force_n = 0;  ///< a Robotiq's force byte 0 is not zero force (docs/hal.md)
   double max_force_n = 235;
 };
 

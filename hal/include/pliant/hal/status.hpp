@@ -12,18 +12,18 @@
 
 namespace pliant::hal {
 
-enum class [[nodiscard]] HalStatus : std::uint8_t {
-  ok = 0,
-  no_data,            ///< read: nothing new since the last read (not an error)
-  wrong_state,        ///< not allowed in the current lifecycle state (e.g. read before start)
-  invalid_argument,   ///< a configuration value or command out of its documented range
-  unsupported,        ///< the device does not offer this (e.g. a fault kind it cannot have)
-  capacity_exceeded,  ///< a fixed capacity is full, or configure could not allocate
-  disconnected,       ///< the device is unreachable; reads fail until it is back
-  timeout,            ///< no response within the transport's timeout (e.g. a Modbus poll)
-  bus_off,            ///< the CAN controller went bus-off
-  device_fault,       ///< the device reports a fault that stops it (see its status bits)
-  io_error,           ///< any other transport error
+enum class [[nodiscard]] HalStatus : std::uint8_t{
+    ok = 0,
+    no_data,            ///< read: nothing new since the last read (not an error)
+    wrong_state,        ///< not allowed in the current lifecycle state (e.g. read before start)
+    invalid_argument,   ///< a configuration value or command out of its documented range
+    unsupported,        ///< the device does not offer this (e.g. a fault kind it cannot have)
+    capacity_exceeded,  ///< a fixed capacity is full, or configure could not allocate
+    disconnected,       ///< the device is unreachable; reads fail until it is back
+    timeout,            ///< no response within the transport's timeout (e.g. a Modbus poll)
+    bus_off,            ///< the CAN controller went bus-off
+    device_fault,       ///< the device reports a fault that stops it (see its status bits)
+    io_error,           ///< any other transport error
 };
 
 /// Short, stable name ("ok", "no_data", "bus_off", ...), for logs.

@@ -45,15 +45,15 @@ struct StreamMonitorConfig {
 };
 
 struct StreamMonitorCounters {
-  std::uint64_t samples = 0;    ///< samples checked
-  std::uint64_t gaps = 0;       ///< samples after a sequence gap
-  std::uint64_t dropped = 0;    ///< samples missing in those gaps
+  std::uint64_t samples = 0;  ///< samples checked
+  std::uint64_t gaps = 0;     ///< samples after a sequence gap
+  std::uint64_t dropped = 0;  ///< samples missing in those gaps
   std::uint64_t stalls = 0;
   std::uint64_t backwards = 0;
   std::uint64_t jumps = 0;
   std::uint64_t frozen = 0;
   std::uint64_t non_finite = 0;
-  std::uint64_t flagged = 0;    ///< samples with any kStreamFaultMask flag
+  std::uint64_t flagged = 0;  ///< samples with any kStreamFaultMask flag
 };
 
 class StreamMonitor {

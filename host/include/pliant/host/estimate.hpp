@@ -38,13 +38,13 @@ struct EstimateReport {
   std::vector<double> curve_beta;
   std::vector<double> curve_error;
   int cluster_count = 0;
-  int rest_frames = 1;             ///< leading still frames averaged into the rest shape
-  double noise_std = 0;            ///< position noise used for the input perturbation
-  double msm_beta_std_curvature = 0;   ///< from the error curve alone (core estimator)
-  double msm_beta_std_input = 0;       ///< spread of refits under perturbed inputs
-  double msm_beta_std = 0;             ///< combined: sqrt(curvature^2 + input^2)
-  double spacing = 0;              ///< median nearest-neighbour distance of the rest shape
-  double frame_interval_s = 0;     ///< mean time step used by the simulation
+  int rest_frames = 1;                ///< leading still frames averaged into the rest shape
+  double noise_std = 0;               ///< position noise used for the input perturbation
+  double msm_beta_std_curvature = 0;  ///< from the error curve alone (core estimator)
+  double msm_beta_std_input = 0;      ///< spread of refits under perturbed inputs
+  double msm_beta_std = 0;            ///< combined: sqrt(curvature^2 + input^2)
+  double spacing = 0;                 ///< median nearest-neighbour distance of the rest shape
+  double frame_interval_s = 0;        ///< mean time step used by the simulation
   double runtime_s = 0;
 };
 
@@ -52,8 +52,7 @@ struct EstimateReport {
 EstimateReport estimate_recording(const Recording& recording, const EstimateOptions& options);
 
 /// The outputs-v1 `pliant-estimate` document for a report.
-nlohmann::json estimate_json(const Recording& recording, const EstimateOptions& options,
-                             const EstimateReport& report);
+nlohmann::json estimate_json(const Recording& recording, const EstimateOptions& options, const EstimateReport& report);
 
 /// "final" / "trajectory" and back; parse throws std::invalid_argument on anything else.
 const char* fit_mode_name(FitMode mode);

@@ -91,8 +91,8 @@ struct Recording {
 
   int frame_count() const { return static_cast<int>(frame_times_s.size()); }
   double position(int frame, int id, int axis) const {
-    return positions[(static_cast<size_t>(frame) * static_cast<size_t>(particle_count) +
-                      static_cast<size_t>(id)) * static_cast<size_t>(dimension) +
+    return positions[(static_cast<size_t>(frame) * static_cast<size_t>(particle_count) + static_cast<size_t>(id)) *
+                         static_cast<size_t>(dimension) +
                      static_cast<size_t>(axis)];
   }
   bool observed(int frame, int id) const;  ///< every coordinate finite
@@ -110,8 +110,7 @@ void parse_recording_json(std::string_view text, const std::string& file_label, 
 /// Requires out.dimension and out.particle_count set; fills frame_times_s and positions.
 void parse_particles_csv(std::string_view text, const std::string& file_label, Recording& out);
 std::vector<WrenchSample> parse_wrench_csv(std::string_view text, const std::string& file_label);
-std::vector<GripperSample> parse_gripper_csv(std::string_view text,
-                                             const std::string& file_label);
+std::vector<GripperSample> parse_gripper_csv(std::string_view text, const std::string& file_label);
 TetMesh parse_vtk_tet_mesh(std::string_view text, const std::string& file_label);
 
 /// Checks cross-file consistency (ids in range, first frame complete unless a mesh is present,

@@ -70,18 +70,18 @@ namespace pliant::host {
 struct ScenarioOptions {
   double msm_beta = 0.5;
   double msm_alpha = 1.0;
-  double noise = 0.0;        ///< position noise std, as a fraction of the particle spacing
+  double noise = 0.0;  ///< position noise std, as a fraction of the particle spacing
   std::uint64_t seed = 1;
-  double rate_hz = 0.0;      ///< frames per second; 0 = the scenario's own rate
+  double rate_hz = 0.0;  ///< frames per second; 0 = the scenario's own rate
   /// Concealed effect: "" or "none" = no effect, else one of effect_names().
   std::string effect;
-  std::map<std::string, double> effect_parameters;        ///< numeric parameters by name
-  std::map<std::string, std::string> effect_labels;       ///< named settings (heterogeneity region)
-  int substeps = 1;                    ///< MSM steps per frame interval, 1..64
-  double cluster_radius_factor = 1.5;  ///< generator's cluster radius / median neighbour distance
-  double occlusion = 0.0;              ///< share of (particle, frame) observations removed, [0, 0.5]
-  double depth = 0.0;                  ///< tool amplitude / object height; 0 = the scenario's own
-  bool release = false;                ///< foam_press, block_press: the tool lets go for the last 1.5 s
+  std::map<std::string, double> effect_parameters;   ///< numeric parameters by name
+  std::map<std::string, std::string> effect_labels;  ///< named settings (heterogeneity region)
+  int substeps = 1;                                  ///< MSM steps per frame interval, 1..64
+  double cluster_radius_factor = 1.5;                ///< generator's cluster radius / median neighbour distance
+  double occlusion = 0.0;                            ///< share of (particle, frame) observations removed, [0, 0.5]
+  double depth = 0.0;                                ///< tool amplitude / object height; 0 = the scenario's own
+  bool release = false;                              ///< foam_press, block_press: the tool lets go for the last 1.5 s
   /// block_press only: particles along x, y and z (z up, layer 0 fixed); each 2..64. Another
   /// scenario refuses a grid other than the default.
   struct BlockGrid {
@@ -125,28 +125,28 @@ namespace detail {
 struct EffectGeometry {
   int dimension = 2;
   double spacing = 1.0;
-  std::vector<double> rest;            ///< particle-major
+  std::vector<double> rest;  ///< particle-major
   std::vector<int> fixed;
   std::vector<double> down;            ///< unit vector: where "down" points in this frame
   std::vector<double> support_normal;  ///< unit vector from the fixed particles into the object
   std::vector<double> inclusion_centre;
-  double default_gravity = 0.0;        ///< g for the gravity effect when not given
+  double default_gravity = 0.0;  ///< g for the gravity effect when not given
 };
 
 /// One effect resolved against a scenario: every MsmParams knob it sets, with defaults filled.
 struct EffectPhysics {
   std::string name = "none";
-  std::map<std::string, double> parameters;      ///< all numeric parameters, defaults filled
-  std::map<std::string, std::string> labels;     ///< all named settings, defaults filled
-  std::vector<double> gravity;                   ///< dimension components
+  std::map<std::string, double> parameters;   ///< all numeric parameters, defaults filled
+  std::map<std::string, std::string> labels;  ///< all named settings, defaults filled
+  std::vector<double> gravity;                ///< dimension components
   double velocity_damping = 0.0;
   double plastic_yield = 0.0, plastic_creep = 0.0, plastic_max = 1.0;
   double relaxation_fraction = 0.0, relaxation_time_s = 1.0;
   double stiffening = 0.0;
   double support_friction = std::numeric_limits<double>::infinity();  ///< infinity = pinned
   std::vector<double> support_normal;
-  double region_beta_ratio = 1.0;                ///< heterogeneity: beta inside / beta outside
-  std::function<bool(const double*)> in_region;  ///< heterogeneity: a rest point in the region
+  double region_beta_ratio = 1.0;                     ///< heterogeneity: beta inside / beta outside
+  std::function<bool(const double*)> in_region;       ///< heterogeneity: a rest point in the region
   nlohmann::json details = nlohmann::json::object();  ///< derived values for truth.json
 };
 

@@ -28,12 +28,14 @@ void check_depth_input(const DepthImageView& image, const PinholeIntrinsics& int
                        const DepthToCloudOptions& options) {
   check_intrinsics(intrinsics);
   if (image.data == nullptr) throw DepthError("depth image: no data");
-  if (image.width < 1 || image.height < 1) throw DepthError("depth image: empty (" + size_text(image.width, image.height) + ")");
+  if (image.width < 1 || image.height < 1)
+    throw DepthError("depth image: empty (" + size_text(image.width, image.height) + ")");
   if (image.width != intrinsics.width || image.height != intrinsics.height) {
     throw DepthError("depth image is " + size_text(image.width, image.height) + " but the intrinsics are for " +
                      size_text(intrinsics.width, intrinsics.height));
   }
-  if (image.stride() < static_cast<std::size_t>(image.width)) throw DepthError("depth image: row_stride is smaller than the width");
+  if (image.stride() < static_cast<std::size_t>(image.width))
+    throw DepthError("depth image: row_stride is smaller than the width");
   check_cloud_options(options, image.width, image.height);
 }
 
@@ -49,7 +51,8 @@ void check_cloud_options(const DepthToCloudOptions& options, int width, int heig
   if (!(std::isfinite(options.min_depth_m) && options.min_depth_m >= 0)) {
     throw DepthError("depth options: min_depth_m must be finite and >= 0");
   }
-  if (!(options.max_depth_m > options.min_depth_m)) throw DepthError("depth options: max_depth_m must exceed min_depth_m");
+  if (!(options.max_depth_m > options.min_depth_m))
+    throw DepthError("depth options: max_depth_m must exceed min_depth_m");
   if (!options.region.empty()) {
     const PixelRect& r = options.region;
     if (r.u0 < 0 || r.v0 < 0 || r.width < 0 || r.height < 0 || r.width > width - r.u0 || r.height > height - r.v0) {

@@ -99,7 +99,8 @@ std::vector<DepthListEntry> parse_recorded_frames(std::string_view text, const s
       throw DepthError(where + "index " + printable(fields[0]) + " is not a whole number");
     }
     DepthListEntry entry;
-    if (!parse_number(fields[1], false, entry.t_s)) throw DepthError(where + "timestamp " + printable(fields[1]) + " is not a number");
+    if (!parse_number(fields[1], false, entry.t_s))
+      throw DepthError(where + "timestamp " + printable(fields[1]) + " is not a number");
     check_follows(entries, entry.t_s, fields[1], where);
     check_file_name(fields[2], where);
     entry.path = std::string(fields[2]);

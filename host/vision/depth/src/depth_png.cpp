@@ -72,7 +72,7 @@ bool read_header(png_structp png, png_infop info, Header* header) {
 bool read_pixels(png_structp png, png_infop info, png_bytep* rows) {
   if (setjmp(png_jmpbuf(png))) return false;
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__
-  // PNG stores 16-bit samples big-endian: host order already.
+    // PNG stores 16-bit samples big-endian: host order already.
 #else
   png_set_swap(png);  // PNG stores 16-bit samples big-endian; we want host order
 #endif
@@ -127,12 +127,14 @@ DepthImage decode_depth_png(const std::uint8_t* bytes, std::size_t size, const s
   PngRead read(source);
   if (!read.ok()) throw DepthError(label + ": cannot start the PNG decoder");
   Header header;
-  if (!read_header(read.png(), read.info(), &header)) throw DepthError(label + ": corrupt PNG (" + source.message + ")");
+  if (!read_header(read.png(), read.info(), &header))
+    throw DepthError(label + ": corrupt PNG (" + source.message + ")");
   if (header.bit_depth != 16) {
     throw DepthError(label + ": depth PNG must be 16-bit (this one is " + std::to_string(header.bit_depth) + "-bit)");
   }
   if (header.color_type != PNG_COLOR_TYPE_GRAY || header.channels != 1) {
-    throw DepthError(label + ": depth PNG must have one channel (this one has " + std::to_string(header.channels) + ")");
+    throw DepthError(label + ": depth PNG must have one channel (this one has " + std::to_string(header.channels) +
+                     ")");
   }
   // Deflate expands at most 1032:1, so a file too small for its claimed size is corrupt: refused
   // before the pixel buffer (up to 512 MiB) is allocated for it.
@@ -149,7 +151,8 @@ DepthImage decode_depth_png(const std::uint8_t* bytes, std::size_t size, const s
   for (png_uint_32 v = 0; v < header.height; ++v) {
     rows[v] = reinterpret_cast<png_bytep>(image.data.data() + static_cast<std::size_t>(v) * header.width);
   }
-  if (!read_pixels(read.png(), read.info(), rows.data())) throw DepthError(label + ": corrupt PNG (" + source.message + ")");
+  if (!read_pixels(read.png(), read.info(), rows.data()))
+    throw DepthError(label + ": corrupt PNG (" + source.message + ")");
   return image;
 }
 

@@ -82,13 +82,15 @@ DepthSequenceResult track_depth_sequence(const host::Recording& plan, const std:
   }
   if (times_s.empty()) throw DepthError("depth sequence: no frames");
   for (std::size_t k = 0; k < times_s.size(); ++k) {
-    if (!std::isfinite(times_s[k])) throw DepthError("depth sequence: time of frame " + std::to_string(k) + " is not finite");
+    if (!std::isfinite(times_s[k]))
+      throw DepthError("depth sequence: time of frame " + std::to_string(k) + " is not finite");
     if (k > 0 && !(times_s[k] > times_s[k - 1])) {
       throw DepthError("depth sequence: frame times must increase strictly (frame " + std::to_string(k) + ")");
     }
   }
   if (!(options.msm_beta >= 0 && options.msm_beta <= 1)) throw DepthError("depth sequence: msm_beta must be in [0, 1]");
-  if (!(options.msm_alpha > 0 && options.msm_alpha <= 1)) throw DepthError("depth sequence: msm_alpha must be in (0, 1]");
+  if (!(options.msm_alpha > 0 && options.msm_alpha <= 1))
+    throw DepthError("depth sequence: msm_alpha must be in (0, 1]");
   if (!frames) throw DepthError("depth sequence: no frame source");
 
   const std::unique_ptr<host::HostMsmModel<3>> model = host::build_msm_model<3>(plan, options.setup);
@@ -113,7 +115,8 @@ DepthSequenceResult track_depth_sequence(const host::Recording& plan, const std:
     if (!everything) std::copy(status, status + n, result.status.begin() + static_cast<std::ptrdiff_t>(k) * n);
     for (int i = 0; i < n; ++i) {
       if (!everything && options.observed_only && status[i] != TrackStatus::observed) continue;
-      for (int d = 0; d < 3; ++d) out.positions[k * per_frame + static_cast<std::size_t>(i) * 3 + static_cast<std::size_t>(d)] = x[i](d);
+      for (int d = 0; d < 3; ++d)
+        out.positions[k * per_frame + static_cast<std::size_t>(i) * 3 + static_cast<std::size_t>(d)] = x[i](d);
     }
   };
 
@@ -139,8 +142,8 @@ DepthSequenceResult track_depth_sequence(const host::Recording& plan, const std:
   result.frames.reserve(times_s.size());
   for (std::size_t k = 1; k < times_s.size(); ++k) {
     driven_targets_at(plan, times_s[k], ids, targets);
-    const MsmDrivenTargets<3, double> driven{ids.empty() ? nullptr : ids.data(), targets.empty() ? nullptr : targets.data(),
-                                             static_cast<int>(ids.size())};
+    const MsmDrivenTargets<3, double> driven{ids.empty() ? nullptr : ids.data(),
+                                             targets.empty() ? nullptr : targets.data(), static_cast<int>(ids.size())};
     const DepthImageView view = frames(static_cast<int>(k));
     calibrating = calibrating && static_cast<int>(k) < options.reference_frames && untouched();
     if (calibrating) tracker.calibrate(view);
@@ -158,7 +161,8 @@ DepthSequenceResult track_depth_sequence(const host::Recording& plan, const std:
   out.meta["depth_tracking"]["frames"] = times_s.size();
   out.meta["depth_tracking"]["empty_frames"] = result.counters.empty_frames;
   out.meta["depth_tracking"]["calibration_frames"] = result.calibration_frames;
-  out.meta["depth_tracking"]["observed_share"] = looked > 0 ? static_cast<double>(observed) / static_cast<double>(looked) : 0.0;
+  out.meta["depth_tracking"]["observed_share"] =
+      looked > 0 ? static_cast<double>(observed) / static_cast<double>(looked) : 0.0;
   return result;
 }
 

@@ -56,7 +56,8 @@ void parse_numbers(std::string_view text, const char* what, const char* const (&
       return byte < 0x20 || byte == 0x7f;
     });
     if (piece.size() > 40 || control || stop != field.c_str() + field.size() || errno == ERANGE) {
-      throw DepthError(prefix + names[i] + " is not a number: '" + printable(field) + (piece.size() > 40 ? "...'" : "'"));
+      throw DepthError(prefix + names[i] + " is not a number: '" + printable(field) +
+                       (piece.size() > 40 ? "...'" : "'"));
     }
     text.remove_prefix(end);
   }

@@ -36,7 +36,8 @@ void check_config(const DepthTrackerConfig& c) {
   auto fail = [](const char* what) { throw DepthError(std::string("depth tracker: ") + what); };
   if (c.plane_neighbours < 3 || c.plane_neighbours > kMaxNeighbours) fail("plane_neighbours must be 3..64");
   if (!(std::isfinite(c.gate_m) && c.gate_m >= 0)) fail("gate_m must be finite and >= 0");
-  if (!(std::isfinite(c.visibility_margin_m) && c.visibility_margin_m >= 0)) fail("visibility_margin_m must be finite and >= 0");
+  if (!(std::isfinite(c.visibility_margin_m) && c.visibility_margin_m >= 0))
+    fail("visibility_margin_m must be finite and >= 0");
   if (c.depth_window < 0 || c.depth_window > 16) fail("depth_window must be 0..16");
   if (!(c.max_view_angle_deg > 0 && c.max_view_angle_deg <= 90)) fail("max_view_angle_deg must be in (0, 90]");
   if (!(c.max_normal_angle_deg > 0 && c.max_normal_angle_deg <= 180)) fail("max_normal_angle_deg must be in (0, 180]");
@@ -139,7 +140,8 @@ DepthTracker::DepthTracker(const MsmModel<3, double>& model, const MsmParams<3, 
   if (status != Status::ok) throw DepthError(std::string("depth tracker: tracker_init: ") + status_name(status));
   s.probe_block.resize(std::max<std::size_t>(msm_state_workspace_size(model), 1));
   Arena probe_arena(s.probe_block.data(), s.probe_block.size());
-  if (msm_state_init(probe_arena, model, s.probe) != Status::ok) throw DepthError("depth tracker: cannot carve the prediction state");
+  if (msm_state_init(probe_arena, model, s.probe) != Status::ok)
+    throw DepthError("depth tracker: cannot carve the prediction state");
 
   const auto n = static_cast<std::size_t>(model.particle_count);
   s.observation.assign(n, Vec::Constant(kNaN));
@@ -154,10 +156,10 @@ DepthTracker::DepthTracker(const MsmModel<3, double>& model, const MsmParams<3, 
   s.rest_normals = estimate_rest_normals(model);
   s.cloud.reserve(cloud_capacity(intrinsics.width, intrinsics.height, config.cloud));
   s.adaptor.points = &s.cloud.points;
-  s.tree = std::make_unique<KdTree>(3, s.adaptor,
-                                    nanoflann::KDTreeSingleIndexAdaptorParams(
-                                        static_cast<std::size_t>(config.leaf_max_size),
-                                        nanoflann::KDTreeSingleIndexAdaptorFlags::SkipInitialBuildIndex));
+  s.tree = std::make_unique<KdTree>(
+      3, s.adaptor,
+      nanoflann::KDTreeSingleIndexAdaptorParams(static_cast<std::size_t>(config.leaf_max_size),
+                                                nanoflann::KDTreeSingleIndexAdaptorFlags::SkipInitialBuildIndex));
   const double spacing = static_cast<double>(model.spacing);
   s.gate_m = config.gate_m > 0 ? config.gate_m : 0.5 * spacing;
   s.margin_m = config.visibility_margin_m > 0 ? config.visibility_margin_m : 0.5 * spacing;
@@ -274,7 +276,8 @@ struct Matcher {
   void run(const DepthImageView& image, const Vec* x, const Eigen::Quaterniond* rotation,
            const std::uint8_t* driven_now, bool use_offsets, DepthFrameReport& report) {
     const int n = model.particle_count;
-    const PixelRect region = config.cloud.region.empty() ? PixelRect{0, 0, image.width, image.height} : config.cloud.region;
+    const PixelRect region =
+        config.cloud.region.empty() ? PixelRect{0, 0, image.width, image.height} : config.cloud.region;
     const std::size_t want = static_cast<std::size_t>(config.plane_neighbours);
     std::uint32_t index[kMaxNeighbours];
     float squared[kMaxNeighbours];
@@ -405,7 +408,7 @@ DepthFrameReport DepthTracker::look(const DepthImageView& depth) {
   report.points = depth_to_cloud_unchecked(depth, intrinsics_, config_.cloud, s.cloud);
   s.tree->buildIndex();
   Matcher{model_, config_, intrinsics_, s}.run(depth, tracker_.state.position, tracker_.state.rotation,
-                                                 tracker_.state.driven_now, true, report);
+                                               tracker_.state.driven_now, true, report);
   return report;
 }
 
@@ -428,7 +431,8 @@ DepthFrameReport DepthTracker::calibrate(const DepthImageView& depth) {
   return report;
 }
 
-DepthFrameReport DepthTracker::update(const DepthImageView& depth, double dt_s, const MsmDrivenTargets<3, double>& driven) {
+DepthFrameReport DepthTracker::update(const DepthImageView& depth, double dt_s,
+                                      const MsmDrivenTargets<3, double>& driven) {
   check_depth_input(depth, intrinsics_, config_.cloud);
   DepthFrameReport report;
   Impl& s = *impl_;
@@ -461,8 +465,8 @@ DepthFrameReport DepthTracker::update(const DepthImageView& depth, double dt_s, 
       s.distance[ii] = kNaN;
       s.confidence[ii] = 0;
       const bool held = model_.fixed[i] != 0 || (s.have_prediction && s.probe.driven_now[i] != 0);
-      s.view[ii] = held ? ParticleView::held
-                        : (s.rest_normals[ii].isZero() ? ParticleView::interior : ParticleView::no_depth);
+      s.view[ii] =
+          held ? ParticleView::held : (s.rest_normals[ii].isZero() ? ParticleView::interior : ParticleView::no_depth);
       ++report.by_view[static_cast<std::size_t>(s.view[ii])];
     }
   }
@@ -474,7 +478,8 @@ DepthFrameReport DepthTracker::update(const DepthImageView& depth, double dt_s, 
   }
   ++counters_.frames;
   if (report.points == 0) ++counters_.empty_frames;
-  for (std::size_t v = 0; v < report.by_view.size(); ++v) counters_.by_view[v] += static_cast<std::uint64_t>(report.by_view[v]);
+  for (std::size_t v = 0; v < report.by_view.size(); ++v)
+    counters_.by_view[v] += static_cast<std::uint64_t>(report.by_view[v]);
   return report;
 }
 

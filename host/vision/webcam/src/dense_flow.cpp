@@ -10,9 +10,7 @@
 
 namespace pliant::vision::webcam {
 
-const char* flow_method_name(FlowMethod method) {
-  return method == FlowMethod::dis ? "dis" : "farneback";
-}
+const char* flow_method_name(FlowMethod method) { return method == FlowMethod::dis ? "dis" : "farneback"; }
 
 FlowMethod parse_flow_method(const std::string& name) {
   if (name == "dis") return FlowMethod::dis;

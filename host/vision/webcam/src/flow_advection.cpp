@@ -41,7 +41,8 @@ void check_advection_config(const AdvectionConfig& c) {
   if (c.refine_window_px != 0 && (c.refine_window_px < 3 || c.refine_window_px > 51 || c.refine_window_px % 2 == 0)) {
     throw InputError("--refine-window must be 0 (off) or odd, 3..51 px");
   }
-  if (c.dis_finest_scale < -1 || c.dis_finest_scale > 4) throw InputError("DIS finest scale must be 0..4 (or -1: from the spacing)");
+  if (c.dis_finest_scale < -1 || c.dis_finest_scale > 4)
+    throw InputError("DIS finest scale must be 0..4 (or -1: from the spacing)");
 }
 
 FlowAdvector::FlowAdvector(FlowMethod method, const AdvectionConfig& config)
@@ -53,7 +54,8 @@ void FlowAdvector::start(const cv::Mat& grey, const std::vector<cv::Point2d>& po
   CV_Assert(grey.type() == CV_8UC1);
   grey.copyTo(previous_);
   templates_.assign(positions.size(), cv::Mat());
-  for (std::size_t i = 0; i < positions.size(); ++i) extract_patch(previous_, positions[i], config_.patch_px, templates_[i]);
+  for (std::size_t i = 0; i < positions.size(); ++i)
+    extract_patch(previous_, positions[i], config_.patch_px, templates_[i]);
 }
 
 PatchMatch FlowAdvector::search(const cv::Mat& templ, const cv::Point2d& a, const cv::Point2d& b) const {
@@ -85,7 +87,8 @@ void FlowAdvector::observe(const cv::Mat& next, const std::vector<cv::Point2d>& 
   out.assign(n, ParticleObservation{});
   advected_.assign(n, cv::Point2d(ParticleObservation::kNaN, ParticleObservation::kNaN));
   for (std::size_t i = 0; i < n; ++i) {
-    if (inside(previous_, positions[i])) advected_[i] = positions[i] + window_mean_flow(forward_, positions[i], config_.window_px);
+    if (inside(previous_, positions[i]))
+      advected_[i] = positions[i] + window_mean_flow(forward_, positions[i], config_.window_px);
   }
   if (config_.refine_window_px > 0) refine(positions);
   for (std::size_t i = 0; i < n; ++i) {

@@ -35,7 +35,8 @@ class VideoSource final : public FrameSource {
     } catch (const cv::Exception&) {
       capture_.release();
     }
-    if (!capture_.isOpened()) throw InputError(name_ + ": cannot open the video (not a video, damaged, or an unknown codec)");
+    if (!capture_.isOpened())
+      throw InputError(name_ + ": cannot open the video (not a video, damaged, or an unknown codec)");
     fps_ = fps_hz;
     if (fps_ == 0) {
       fps_ = capture_.get(cv::CAP_PROP_FPS);

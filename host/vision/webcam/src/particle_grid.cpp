@@ -107,7 +107,8 @@ ParticleGrid seed_particles(const Region& region, const GridSpec& spec, const cv
       (spec.rows == 0) != (spec.cols == 0)) {
     throw InputError("--grid: rows and columns must both be given, 1.." + std::to_string(kMaxGridSide));
   }
-  if (!(std::isfinite(spec.spacing_px) && spec.spacing_px >= 0)) throw InputError("--spacing must be a finite number of pixels");
+  if (!(std::isfinite(spec.spacing_px) && spec.spacing_px >= 0))
+    throw InputError("--spacing must be a finite number of pixels");
   if (spec.spacing_px > 0 && spec.spacing_px < 2) throw InputError("--spacing must be at least 2 px");
   if (spec.rows == 0 && spec.spacing_px == 0) throw InputError("give --grid, --spacing or both");
 

@@ -25,8 +25,8 @@ double parabola_peak(double a, double b, double c) {
 
 void extract_patch(const cv::Mat& grey, const cv::Point2d& p, int size_px, cv::Mat& patch) {
   CV_Assert(grey.type() == CV_8UC1 && size_px >= 1 && size_px % 2 == 1);
-  cv::getRectSubPix(grey, cv::Size(size_px, size_px), cv::Point2f(static_cast<float>(p.x), static_cast<float>(p.y)), patch,
-                    CV_32F);
+  cv::getRectSubPix(grey, cv::Size(size_px, size_px), cv::Point2f(static_cast<float>(p.x), static_cast<float>(p.y)),
+                    patch, CV_32F);
 }
 
 double patch_similarity(const cv::Mat& a, const cv::Mat& b) {

@@ -146,7 +146,8 @@ TrackResult track_particles(FrameReader& reader, const Region& region, const Gri
       result.tracked.emplace_back(p(0), p(1));
       const bool used = observations == nullptr || tracker.weight[i] > 0 || tracker.state.driven_now[i] != 0;
       result.observed.push_back(used ? 1 : 0);
-      result.status.push_back(static_cast<std::uint8_t>(observations == nullptr ? TrackStatus::observed : tracker.status[i]));
+      result.status.push_back(
+          static_cast<std::uint8_t>(observations == nullptr ? TrackStatus::observed : tracker.status[i]));
       if (observations == nullptr) {
         result.check.push_back(static_cast<std::uint8_t>(ObservationKind::advected));
         result.fb_error_px.push_back(0.0f);

@@ -51,6 +51,7 @@ struct FaultScriptError {
 
 /// Parses `text` ([length] bytes) into `script` (cleared first). ok, or invalid_argument /
 /// capacity_exceeded (more than kFaultCapacity events for one device) with `error` set.
-HalStatus parse_fault_script(const char* text, std::size_t length, FaultScript& script, FaultScriptError& error) noexcept;
+HalStatus parse_fault_script(const char* text, std::size_t length, FaultScript& script,
+                             FaultScriptError& error) noexcept;
 
 }  // namespace pliant::hal

@@ -37,18 +37,19 @@ struct MockDepthCameraConfig {
   int width = 64, height = 48;  ///< 1..4096
   double period_s = 1.0 / 30;
   double latency_s = 0;
-  double plane_depth_m = 0.6;      ///< (0, 65]
+  double plane_depth_m = 0.6;  ///< (0, 65]
   double tilt_m_per_px = 5e-4;
   double bump_height_m = 0.05;
-  double noise_mm = 2;             ///< >= 0
-  double fov_x_deg = 58;           ///< (0, 180)
+  double noise_mm = 2;    ///< >= 0
+  double fov_x_deg = 58;  ///< (0, 180)
   std::uint32_t fault_bits = kFrameDeviceFault;
   std::uint64_t seed = 5;
 };
 
 class MockColorCamera final : public ColorCamera {
  public:
-  explicit MockColorCamera(const Clock& clock, const MockColorCameraConfig& config = {}) noexcept : clock_(clock), config_(config) {}
+  explicit MockColorCamera(const Clock& clock, const MockColorCameraConfig& config = {}) noexcept
+      : clock_(clock), config_(config) {}
   HalStatus set_fault_schedule(const FaultSchedule& schedule) noexcept { return stream_.set_schedule(schedule); }
   HalStatus add_fault(const FaultEvent& event) noexcept { return stream_.add_fault(event); }
   const FaultCounters& fault_counters() const noexcept { return stream_.fault_counters(); }
@@ -71,7 +72,8 @@ class MockColorCamera final : public ColorCamera {
 
 class MockDepthCamera final : public DepthCamera {
  public:
-  explicit MockDepthCamera(const Clock& clock, const MockDepthCameraConfig& config = {}) noexcept : clock_(clock), config_(config) {}
+  explicit MockDepthCamera(const Clock& clock, const MockDepthCameraConfig& config = {}) noexcept
+      : clock_(clock), config_(config) {}
   HalStatus set_fault_schedule(const FaultSchedule& schedule) noexcept { return stream_.set_schedule(schedule); }
   HalStatus add_fault(const FaultEvent& event) noexcept { return stream_.add_fault(event); }
   const FaultCounters& fault_counters() const noexcept { return stream_.fault_counters(); }

@@ -23,8 +23,8 @@ namespace pliant::hal {
 
 struct MockForceTorqueConfig {
   double period_s = 0.001;
-  double force_noise_n = 0.02;     ///< sd per axis, >= 0
-  double torque_noise_nm = 5e-4;   ///< sd per axis, >= 0
+  double force_noise_n = 0.02;                       ///< sd per axis, >= 0
+  double torque_noise_nm = 5e-4;                     ///< sd per axis, >= 0
   double rotation[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};  ///< sensor axes (columns) in world, row-major
   double lever_m[3] = {0, 0, -0.03};
   double load_n[3] = {0, 0, -0.5};

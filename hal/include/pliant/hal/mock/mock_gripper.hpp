@@ -25,13 +25,13 @@
 namespace pliant::hal {
 
 struct MockGripperConfig {
-  double period_s = 0.001;           ///< > 0
-  double width_noise_m = 5e-6;       ///< sd, >= 0
-  double force_noise_n = 0.005;      ///< sd, >= 0
-  double current_gain_n_per_a = 100; ///< > 0
+  double period_s = 0.001;            ///< > 0
+  double width_noise_m = 5e-6;        ///< sd, >= 0
+  double force_noise_n = 0.005;       ///< sd, >= 0
+  double current_gain_n_per_a = 100;  ///< > 0
   double current_offset_a = 0.05;
-  double current_noise_a = 2e-4;     ///< sd, >= 0
-  double min_force_n = 0;            ///< reported in limits()
+  double current_noise_a = 2e-4;  ///< sd, >= 0
+  double min_force_n = 0;         ///< reported in limits()
   double max_force_n = 235;
   double max_speed_m_per_s = 0.15;
   std::uint8_t fault_code = kGripperFaultOverCurrent;  ///< default fault_bits code

@@ -27,16 +27,17 @@ namespace pliant::hal {
 
 struct MockParticleObserverConfig {
   double period_s = 1.0 / 30;
-  double latency_s = 0;          ///< >= 0
-  double noise_m = 5e-5;         ///< sd per coordinate, >= 0
-  double occlusion_fraction = 0; ///< [0, 1)
+  double latency_s = 0;           ///< >= 0
+  double noise_m = 5e-5;          ///< sd per coordinate, >= 0
+  double occlusion_fraction = 0;  ///< [0, 1)
   std::uint32_t fault_bits = kFrameDeviceFault;
   std::uint64_t seed = 3;
 };
 
 class MockParticleObserver final : public ParticleObserver {
  public:
-  MockParticleObserver(SimulatedGrasp& plant, const Clock& clock, const MockParticleObserverConfig& config = {}) noexcept
+  MockParticleObserver(SimulatedGrasp& plant, const Clock& clock,
+                       const MockParticleObserverConfig& config = {}) noexcept
       : plant_(plant), clock_(clock), config_(config) {}
 
   HalStatus set_fault_schedule(const FaultSchedule& schedule) noexcept { return stream_.set_schedule(schedule); }
@@ -59,11 +60,11 @@ class MockParticleObserver final : public ParticleObserver {
   std::normal_distribution<double> normal_{0.0, 1.0};
   int n_ = 0;
   int slots_ = 0;
-  std::vector<double> captured_;             ///< [slots][n * 3] true positions
-  std::vector<std::int64_t> slot_index_;     ///< capture index held by each slot, -1: none
+  std::vector<double> captured_;          ///< [slots][n * 3] true positions
+  std::vector<std::int64_t> slot_index_;  ///< capture index held by each slot, -1: none
   std::int64_t next_capture_ = 0;
-  std::vector<double> frame_;                ///< the delivered frame
-  std::vector<int> occlusion_order_;         ///< particles by descending rest y
+  std::vector<double> frame_;         ///< the delivered frame
+  std::vector<int> occlusion_order_;  ///< particles by descending rest y
   SampleHeader last_header_;
   int last_observed_ = 0;
   bool has_last_ = false;

@@ -28,7 +28,10 @@ class MockStream {
   /// Starts the sample clock at t_start_s (sample 0 is captured then). Sequence numbers restart
   /// only in restart_sequence (configure); start/stop cycles continue them.
   void start(double t_start_s) noexcept;
-  void restart_sequence() noexcept { next_index_ = 0; started_ = false; }
+  void restart_sequence() noexcept {
+    next_index_ = 0;
+    started_ = false;
+  }
 
   /// The read fault active at now_s (disconnect, bus_off, timeout in that order), counted; ok
   /// when none.

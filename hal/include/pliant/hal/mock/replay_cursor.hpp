@@ -53,7 +53,7 @@ struct ReplaySample {
   double stamp_s = 0;
   std::uint64_t sequence = 0;
   std::uint32_t status_bits = 0;
-  int index = -1;  ///< the recorded sample the values come from
+  int index = -1;       ///< the recorded sample the values come from
   ActiveFaults faults;  ///< the sample faults active at its stamp (occlude is left to the caller)
 };
 
@@ -96,7 +96,7 @@ class ReplayCursor {
   std::uint32_t default_fault_bits_ = 0;
   std::vector<double> row_;  ///< the last delivered values (freeze_data repeats them)
   double anchor_s_ = 0;
-  int next_ = 0;             ///< first sample not yet taken
+  int next_ = 0;  ///< first sample not yet taken
   int last_index_ = -1;
   bool started_ = false;
   bool has_last_ = false;

@@ -102,7 +102,7 @@ class ReplayParticleObserver final : public ParticleObserver {
   const Clock& clock_;
   ReplayTiming timing_;
   ReplayCursor cursor_;
-  std::vector<double> frame_;       ///< the delivered frame (occlusion applied)
+  std::vector<double> frame_;         ///< the delivered frame (occlusion applied)
   std::vector<int> occlusion_order_;  ///< particles by decreasing first-sample y
 };
 

@@ -57,26 +57,26 @@ struct SimulatedObjectConfig {
   /// box: particles along x, y, z (each >= 2). cylinder: radius nx cells (2 nx + 1 particles
   /// across, in x and y), nz particles along its axis z; ny unused. ball: radius nx cells.
   int nx = 6, ny = 5, nz = 4;
-  double spacing_m = 0.008;  ///< lattice spacing, > 0
-  double msm_beta = 0.5;     ///< [0, 1]
+  double spacing_m = 0.008;         ///< lattice spacing, > 0
+  double msm_beta = 0.5;            ///< [0, 1]
   double stiffness_n_per_m = 2000;  ///< > 0
   double stiffening = 0;            ///< >= 0
 };
 
 struct SimulatedGraspConfig {
   SimulatedObjectConfig object;
-  double period_s = 0.001;               ///< > 0
-  int max_steps_per_period = 24;         ///< >= 1
-  double settle_tolerance = 1e-6;        ///< x spacing, > 0
-  double jaw_max_speed_m_per_s = 0.15;   ///< > 0
-  double max_width_m = 0.085;            ///< > extent
+  double period_s = 0.001;                                            ///< > 0
+  int max_steps_per_period = 24;                                      ///< >= 1
+  double settle_tolerance = 1e-6;                                     ///< x spacing, > 0
+  double jaw_max_speed_m_per_s = 0.15;                                ///< > 0
+  double max_width_m = 0.085;                                         ///< > extent
   double initial_width_m = std::numeric_limits<double>::quiet_NaN();  ///< NaN: max_width_m
-  double max_closure_fraction = 0.5;     ///< (0, 1)
-  int max_catch_up_periods = 2000;       ///< >= 1
+  double max_closure_fraction = 0.5;                                  ///< (0, 1)
+  int max_catch_up_periods = 2000;                                    ///< >= 1
 };
 
 struct SimulatedGraspCounters {
-  std::uint64_t periods = 0;         ///< periods simulated
+  std::uint64_t periods = 0;  ///< periods simulated
   std::uint64_t msm_steps = 0;
   std::uint64_t unsettled_periods = 0;  ///< periods that used every step without settling
   std::uint64_t skipped_periods = 0;    ///< periods skipped by a sync() beyond max_catch_up_periods
@@ -152,8 +152,8 @@ class SimulatedGrasp {
   MsmModel<3, double> model_;
   MsmState<3, double> state_;
   MsmParams<3, double> params_;
-  std::vector<Eigen::Matrix3d> span_;       ///< per cluster: projector onto its span
-  std::vector<std::int8_t> side_;           ///< -1 jaw A, +1 jaw B, 0 free
+  std::vector<Eigen::Matrix3d> span_;  ///< per cluster: projector onto its span
+  std::vector<std::int8_t> side_;      ///< -1 jaw A, +1 jaw B, 0 free
   std::vector<Vec> anchor_;
   std::vector<double> anchor_closure_;
   std::vector<std::uint8_t> initial_contact_;

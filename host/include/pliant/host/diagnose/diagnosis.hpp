@@ -15,10 +15,10 @@ namespace pliant::host {
 /// A fitted model: parameter name -> value (names from recording-v1 "Parameter names" plus the
 /// effect parameters), with one standard deviation per parameter where known.
 struct FittedModel {
-  std::string model = "msm";                 ///< "msm" or "fem"
-  std::map<std::string, double> parameters;  ///< e.g. {"msm_alpha": 1, "msm_beta": 0.58}
+  std::string model = "msm";                    ///< "msm" or "fem"
+  std::map<std::string, double> parameters;     ///< e.g. {"msm_alpha": 1, "msm_beta": 0.58}
   std::map<std::string, double> parameter_std;  ///< same keys (subset); absent: not computed
-  double rms = 0;                            ///< held-out output-error rms, length_unit
+  double rms = 0;                               ///< held-out output-error rms, length_unit
   /// FEM with a measured wrench: held-out rms of the force residual (N); NaN otherwise (then
   /// absent from the JSON). `rms` is NaN (JSON null) when no free node position is compared.
   double force_rms = std::numeric_limits<double>::quiet_NaN();
@@ -28,8 +28,8 @@ struct Candidate {
   std::string effect;                        ///< a word of the spec's effect table
   std::map<std::string, double> parameters;  ///< effect parameters only (and refitted msm_beta)
   std::map<std::string, double> parameter_std;
-  double rms = 0;   ///< held-out rms
-  double bic = 0;   ///< Bayesian information criterion on the fitting frames (lower is better)
+  double rms = 0;  ///< held-out rms
+  double bic = 0;  ///< Bayesian information criterion on the fitting frames (lower is better)
   double force_rms = std::numeric_limits<double>::quiet_NaN();  ///< held-out force rms (N), FEM only
 };
 
@@ -67,7 +67,7 @@ struct DiagnosisEvidence {
   int particle_count = 0;
   std::string length_unit = "m";
   std::vector<double> frame_times_s;
-  std::vector<unsigned char> held_out;  ///< [frames] 1 where the frame was held out of fitting
+  std::vector<unsigned char> held_out;     ///< [frames] 1 where the frame was held out of fitting
   std::vector<double> residual_baseline;   ///< [frames * particle_count]
   std::vector<double> residual_augmented;  ///< [frames * particle_count]; equals baseline when consistent
   /// Trajectories, frame-major [frames * particle_count * dimension], NaN where unobserved.

@@ -23,9 +23,9 @@ enum class Scale {
 };
 
 struct EffectParameter {
-  std::string name;       ///< key in the JSON ("yield", "creep", "slip", "g_x", ...)
-  double lower = 0;       ///< physical value at u = 0
-  double upper = 1;       ///< physical value at u = 1
+  std::string name;  ///< key in the JSON ("yield", "creep", "slip", "g_x", ...)
+  double lower = 0;  ///< physical value at u = 0
+  double upper = 1;  ///< physical value at u = 1
   /// Value at which the effect vanishes; NaN when the parameter has no null of its own (a time
   /// constant, a yield strain, a per-patch stiffness) and is not tested against one.
   double null_value = 0;
@@ -49,9 +49,9 @@ struct EffectParameter {
 /// What the effects need to know about the recording and the located mismatch.
 struct EffectContext {
   int dimension = 2;
-  double object_size = 1;          ///< largest extent of the rest shape, length_unit
-  bool has_support = false;        ///< fixed particles span a support line / plane
-  std::vector<int> located;        ///< particles where the residual concentrates
+  double object_size = 1;    ///< largest extent of the rest shape, length_unit
+  bool has_support = false;  ///< fixed particles span a support line / plane
+  std::vector<int> located;  ///< particles where the residual concentrates
   int particle_count = 0;
   /// Spatial patches of the rest shape (each a list of particle ids; together every particle
   /// once): the control regions of the heterogeneity effect.

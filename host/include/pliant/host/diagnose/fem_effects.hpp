@@ -27,18 +27,18 @@ namespace pliant::host {
 
 struct FemEffectContext {
   bool quasi_static = true;
-  bool force_measured = false;      ///< some frame compares the simulated force with the wrench
+  bool force_measured = false;  ///< some frame compares the simulated force with the wrench
   bool has_wrench = false;
   bool positions_compared = false;  ///< some free node is observed
   bool unloads = false;             ///< the drive or load falls back after its peak
   double frame_interval_s = 1;      ///< mean interval between solved frames
   double recording_interval_s = 1;  ///< mean interval between the recording's frames
   double duration_s = 1;
-  double peak_strain = 0.1;         ///< largest element strain of the baseline run
-  double lowest_omega_rad_s = 0;    ///< of the baseline (0: unknown)
-  std::vector<int> element_patch;   ///< patch index per element (heterogeneity)
+  double peak_strain = 0.1;        ///< largest element strain of the baseline run
+  double lowest_omega_rad_s = 0;   ///< of the baseline (0: unknown)
+  std::vector<int> element_patch;  ///< patch index per element (heterogeneity)
   int patch_count = 0;
-  int reference_patch = 0;          ///< the patch whose factor stays 1 (the largest)
+  int reference_patch = 0;  ///< the patch whose factor stays 1 (the largest)
 };
 
 struct FemEffect {

@@ -56,13 +56,13 @@ namespace pliant::host {
 struct FemRunSettings {
   double youngs_modulus_pa = 1e5;
   Eigen::Vector3d extra_gravity_m_s2 = Eigen::Vector3d::Zero();
-  double stiffening = 0;            ///< k in E exp(k eps^2) (dimensionless); 0: linear material
-  double relaxation_fraction = 0;   ///< g; 0: no relaxation
+  double stiffening = 0;           ///< k in E exp(k eps^2) (dimensionless); 0: linear material
+  double relaxation_fraction = 0;  ///< g; 0: no relaxation
   double relaxation_time_s = 1;
-  double extra_rayleigh_beta = 0;   ///< s; dynamic mode only
-  double plastic_yield = 0;         ///< equivalent strain
-  double plastic_creep = 0;         ///< 1/s; 0: no plasticity
-  double wrench_latency_s = 0;      ///< s; positive: the wrench stream lags
+  double extra_rayleigh_beta = 0;      ///< s; dynamic mode only
+  double plastic_yield = 0;            ///< equivalent strain
+  double plastic_creep = 0;            ///< 1/s; 0: no plasticity
+  double wrench_latency_s = 0;         ///< s; positive: the wrench stream lags
   std::vector<double> element_factor;  ///< per element; empty: 1 everywhere
 };
 
@@ -70,7 +70,7 @@ enum class FemTimeMode { quasi_static, dynamic };
 
 struct FemRun {
   bool ok = true;
-  std::string failure;             ///< why ok is false
+  std::string failure;  ///< why ok is false
   /// Recording::positions layout (frame-major, [(frame * n + id) * 3 + axis]); NaN in frames
   /// that were not solved.
   std::vector<double> positions;

@@ -32,10 +32,10 @@
 namespace pliant::host {
 
 struct LocateOptions {
-  double min_ratio = 1.5;         ///< "clearly above": rms above min_ratio * noise rms ...
-  double z = 3.0;                 ///< ... and mean square z standard errors above the noise
-  double energy_fraction = 0.8;   ///< located particles cover this share of the excess energy
-  int bridge_frames = 2;          ///< runs separated by at most this many frames are joined
+  double min_ratio = 1.5;        ///< "clearly above": rms above min_ratio * noise rms ...
+  double z = 3.0;                ///< ... and mean square z standard errors above the noise
+  double energy_fraction = 0.8;  ///< located particles cover this share of the excess energy
+  int bridge_frames = 2;         ///< runs separated by at most this many frames are joined
 };
 
 /// Particles: each particle's excess energy is (rms_i^2 - dim * noise^2) * observed_frames_i

@@ -23,12 +23,12 @@ struct ModelSettings {
   std::vector<double> extra_gravity;  ///< undeclared body acceleration (empty: none), length_unit/s^2
   double velocity_damping = 0;        ///< 1/s
   double plastic_yield = 0;
-  double plastic_creep = 0;           ///< 1/s; 0 = no plasticity
+  double plastic_creep = 0;  ///< 1/s; 0 = no plasticity
   double plastic_max = 1;
-  double relaxation_fraction = 0;     ///< g1; 0 = no relaxation
+  double relaxation_fraction = 0;  ///< g1; 0 = no relaxation
   double relaxation_time_s = 1;
   double stiffening = 0;
-  double support_friction = -1;       ///< mu; negative = pinned supports
+  double support_friction = -1;  ///< mu; negative = pinned supports
   /// Per-particle msm_beta, particle_count values (empty: msm_beta everywhere). A cluster takes
   /// the mean over its members, so a stiffness map needs no cluster bookkeeping by the caller.
   std::vector<double> particle_beta;

@@ -32,7 +32,7 @@ struct ResidualField {
            static_cast<std::size_t>(dimension);
   }
   const double* at(int frame, int id) const { return residual.data() + index(frame, id); }
-  bool observed(int frame, int id) const;       ///< residual of the pair is finite
+  bool observed(int frame, int id) const;        ///< residual of the pair is finite
   double squared_norm(int frame, int id) const;  ///< |r|^2, NaN when unobserved
 };
 

@@ -23,12 +23,12 @@
 // The generated data, and how they avoid the "inverse crime" (the estimator fitting data made
 // by its own discretisation): the load is a force and torque spread over the end face
 // (add_spread_wrench), scaled so that the largest node displacement of the (nonlinear) static
-// response is max_initial_displacement_m (to 1e-4 relative); the static equilibrium under it is frame 0, at rest. Then the load
-// is removed and the bar moves freely, integrated with Newmark (average acceleration) at
-// generator_substeps substeps per frame (default 32, h = 1 ms) with up to 3 Newton iterations to
-// 1e-9 m, where the estimator steps 4 times per frame with one linearised Newton iteration (its
-// time-discretisation error is then what it would be on real data). Optional Gaussian noise is added to the observed positions. The mesh itself is
-// shared (a recording carries its mesh; PHYSICS.md).
+// response is max_initial_displacement_m (to 1e-4 relative); the static equilibrium under it is frame 0, at rest. Then
+// the load is removed and the bar moves freely, integrated with Newmark (average acceleration) at generator_substeps
+// substeps per frame (default 32, h = 1 ms) with up to 3 Newton iterations to 1e-9 m, where the estimator steps 4 times
+// per frame with one linearised Newton iteration (its time-discretisation error is then what it would be on real data).
+// Optional Gaussian noise is added to the observed positions. The mesh itself is shared (a recording carries its mesh;
+// PHYSICS.md).
 //
 // Observation: every surface node in every frame (clamped nodes included); interior nodes are
 // NaN (unobserved). Recording: dimension 3, metres, fixed = the clamped face (x = 0), masses =
@@ -74,8 +74,8 @@ struct BarVibrationOptions {
   double frame_rate_hz = 30;  ///< frames at t = f / frame_rate_hz
   int frame_count = 250;      ///< >= 3
   int generator_substeps = 32;
-  double noise_m = 0;         ///< standard deviation of Gaussian noise per coordinate (m)
-  std::uint64_t seed = 1;     ///< for the noise (std::mt19937_64)
+  double noise_m = 0;      ///< standard deviation of Gaussian noise per coordinate (m)
+  std::uint64_t seed = 1;  ///< for the noise (std::mt19937_64)
 };
 
 struct BarVibrationScenario {
@@ -84,10 +84,10 @@ struct BarVibrationScenario {
   std::vector<double> control_youngs_modulus_pa;  ///< the truth, per control point
   double rayleigh_alpha = 0;
   double rayleigh_beta = 0;
-  Eigen::VectorXd element_youngs_modulus_pa;      ///< the truth per tetrahedron
-  std::vector<int> clamped_nodes;                 ///< x = 0 face (recording.fixed)
-  std::vector<int> tip_nodes;                     ///< x = L face, where the load acted
-  Eigen::Vector3d load_force_n = Eigen::Vector3d::Zero();   ///< the scaled load actually applied
+  Eigen::VectorXd element_youngs_modulus_pa;               ///< the truth per tetrahedron
+  std::vector<int> clamped_nodes;                          ///< x = 0 face (recording.fixed)
+  std::vector<int> tip_nodes;                              ///< x = L face, where the load acted
+  Eigen::Vector3d load_force_n = Eigen::Vector3d::Zero();  ///< the scaled load actually applied
   Eigen::Vector3d load_torque_nm = Eigen::Vector3d::Zero();
 };
 

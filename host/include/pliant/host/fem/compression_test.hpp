@@ -97,14 +97,14 @@ inline constexpr std::size_t kMaxCompressionCsvBytes = std::size_t{256} << 20;
 
 /// One compression test as read from its CSV, in SI units.
 struct CompressionTest {
-  std::string label;        ///< file label used in messages (the path as given)
-  std::string sample_name;  ///< empty when the file names none
-  std::vector<std::string> notes;  ///< other metadata lines without ':' ("Compression test")
-  double diameter_m = 0.0;  ///< specimen diameter before the test
-  double height_m = 0.0;    ///< specimen height before the test
+  std::string label;                    ///< file label used in messages (the path as given)
+  std::string sample_name;              ///< empty when the file names none
+  std::vector<std::string> notes;       ///< other metadata lines without ':' ("Compression test")
+  double diameter_m = 0.0;              ///< specimen diameter before the test
+  double height_m = 0.0;                ///< specimen height before the test
   std::optional<double> speed_m_per_s;  ///< crosshead speed, when the file gives it
-  std::string machine;    ///< empty when absent
-  std::string load_cell;  ///< empty when absent, as written ("1kN")
+  std::string machine;                  ///< empty when absent
+  std::string load_cell;                ///< empty when absent, as written ("1kN")
   std::vector<std::pair<std::string, std::string>> other_metadata;  ///< unknown "key: value"
 
   /// Columns, one entry per row. Required:
@@ -137,8 +137,7 @@ struct LinearModulusFit {
 };
 /// Throws std::invalid_argument when the window is empty or inverted, or holds fewer than two
 /// rows with distinct strains.
-LinearModulusFit fit_linear_modulus(const CompressionTest& test, double from_strain,
-                                    double to_strain);
+LinearModulusFit fit_linear_modulus(const CompressionTest& test, double from_strain, double to_strain);
 
 enum class PlatenContact { frictionless, bonded };
 enum class LateralExpansion { small_strain, finite_strain };
@@ -157,12 +156,12 @@ struct CompressionRecordingOptions {
   double frame_interval_s = 1.0;  ///< > 0; frames at t0, t0 + dt, ... up to the last sample
   PlatenContact platen_contact = PlatenContact::frictionless;
   LateralExpansion lateral_expansion = LateralExpansion::small_strain;  ///< frictionless only
-  double poisson_ratio = 0.49;   ///< material.poisson_ratio, in [0, 0.5)
-  double density_kg_m3 = 1070;   ///< material.density (Ecoflex 00-30 / 00-50: 1.07 g/cm^3)
-  CylinderMeshDivisions mesh;    ///< default (2, 24, 5): 582 nodes, 2520 tetrahedra
-  std::string name;     ///< Recording::name; the sample name when empty
-  std::string source;   ///< meta.source (dataset, URL, commit); omitted when empty
-  std::string license;  ///< meta.license; omitted when empty
+  double poisson_ratio = 0.49;                                          ///< material.poisson_ratio, in [0, 0.5)
+  double density_kg_m3 = 1070;  ///< material.density (Ecoflex 00-30 / 00-50: 1.07 g/cm^3)
+  CylinderMeshDivisions mesh;   ///< default (2, 24, 5): 582 nodes, 2520 tetrahedra
+  std::string name;             ///< Recording::name; the sample name when empty
+  std::string source;           ///< meta.source (dataset, URL, commit); omitted when empty
+  std::string license;          ///< meta.license; omitted when empty
 };
 
 /// Upper bound on the frames of a converted recording; frames x mesh points x 3 must also stay
@@ -174,8 +173,7 @@ inline constexpr int kMaxCompressionFrames = 1'000'000;
 /// option), also when they leave fewer than two frames, and RecordingError (labelled with
 /// test.label) when the test itself cannot make a recording: inconsistent columns, or a test
 /// that never compresses (largest compression not positive). Linear in frames x platen nodes.
-Recording compression_test_recording(const CompressionTest& test,
-                                     const CompressionRecordingOptions& options);
+Recording compression_test_recording(const CompressionTest& test, const CompressionRecordingOptions& options);
 
 /// The lateral stretch of the platen nodes for frictionless platens (see above) at engineering
 /// strain `strain` = compression / height.

@@ -44,13 +44,11 @@ inline constexpr long long kMaxCylinderTets = 5'000'000;
 /// The mesh described above; `youngs_modulus` is left empty. Throws std::invalid_argument when a
 /// dimension is not finite and positive, a division count is out of range (see
 /// CylinderMeshDivisions) or the mesh would exceed kMaxCylinderTets.
-TetMesh cylinder_tet_mesh(double diameter_m, double height_m, int radial_divisions,
-                          int circumferential_divisions, int axial_layers);
+TetMesh cylinder_tet_mesh(double diameter_m, double height_m, int radial_divisions, int circumferential_divisions,
+                          int axial_layers);
 
-inline TetMesh cylinder_tet_mesh(double diameter_m, double height_m,
-                                 const CylinderMeshDivisions& divisions) {
-  return cylinder_tet_mesh(diameter_m, height_m, divisions.radial, divisions.circumferential,
-                           divisions.axial);
+inline TetMesh cylinder_tet_mesh(double diameter_m, double height_m, const CylinderMeshDivisions& divisions) {
+  return cylinder_tet_mesh(diameter_m, height_m, divisions.radial, divisions.circumferential, divisions.axial);
 }
 
 /// Signed volume of tetrahedron `tet` of `mesh` (m^3 for a mesh in metres): positive when its

@@ -127,8 +127,8 @@ struct TrajectoryEstimateOptions {
   /// Starting values without a warm start, and the warm start's reference modulus E0.
   /// initial_youngs_modulus_pa = 0: problem.material.youngs_modulus_pa.
   double initial_youngs_modulus_pa = 0;
-  double initial_rayleigh_alpha = 0.1;   ///< 1/s
-  double initial_rayleigh_beta = 1e-3;   ///< s
+  double initial_rayleigh_alpha = 0.1;  ///< 1/s
+  double initial_rayleigh_beta = 1e-3;  ///< s
 
   /// Bounds of the fit (log scale, so all > 0).
   double youngs_modulus_min_pa = 1e2, youngs_modulus_max_pa = 1e10;
@@ -208,16 +208,16 @@ struct TrajectoryEstimate {
   double start_residual_rms_m = 0;  ///< rms of (simulated - observed) over residual coordinates
   double residual_rms_m = 0;        ///< the same at the solution
   int residual_count = 0;
-  int iterations = 0;               ///< of the fit on the whole record
-  int evaluations = 0;              ///< residual-function calls of that fit
-  int window_iterations = 0;        ///< of the continuation fits on leading windows
+  int iterations = 0;         ///< of the fit on the whole record
+  int evaluations = 0;        ///< residual-function calls of that fit
+  int window_iterations = 0;  ///< of the continuation fits on leading windows
   int window_evaluations = 0;
-  int simulations = 0;              ///< forward simulations run (cached repeats not counted;
-                                    ///< look-ahead ones counted, used or not)
+  int simulations = 0;  ///< forward simulations run (cached repeats not counted;
+                        ///< look-ahead ones counted, used or not)
   bool converged = false;
-  std::string message;              ///< the optimiser's summary
-  double wall_time_s = 0;           ///< warm start + fit
-  double cpu_time_s = 0;            ///< process CPU time over the same span (all threads)
+  std::string message;     ///< the optimiser's summary
+  double wall_time_s = 0;  ///< warm start + fit
+  double cpu_time_s = 0;   ///< process CPU time over the same span (all threads)
   FitResult fit;
 };
 

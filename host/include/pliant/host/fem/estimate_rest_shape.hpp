@@ -109,17 +109,17 @@ struct RestShapeOptions {
 
 struct RestShapeResult {
   bool converged = false;
-  int iterations = 0;           ///< Newton iterations (all load steps) or inverse-sag iterations
-  int load_steps = 0;           ///< Newton: load steps converged (1: full load at once)
+  int iterations = 0;             ///< Newton iterations (all load steps) or inverse-sag iterations
+  int load_steps = 0;             ///< Newton: load steps converged (1: full load at once)
   double initial_residual_n = 0;  ///< largest |r| over free DOFs at X = x_s (the load to carry)
-  double residual_n = 0;        ///< largest |r| over free DOFs at the returned X
-  double last_update_m = 0;     ///< largest component of the last full update of X
+  double residual_n = 0;          ///< largest |r| over free DOFs at the returned X
+  double last_update_m = 0;       ///< largest component of the last full update of X
   /// Rest positions (3n, m); fixed nodes equal x_s. Valid when converged; otherwise the last
   /// iterate (for a stalled load continuation: the rest shape for the last load factor reached).
   Eigen::VectorXd rest_position_m;
-  double max_sag_m = 0;         ///< largest node distance |x_s_i - X_i|
-  double mean_sag_m = 0;        ///< mean node distance |x_s_i - X_i| over all nodes
-  double total_mass_kg = 0;     ///< density x rest volume of X
+  double max_sag_m = 0;      ///< largest node distance |x_s_i - X_i|
+  double mean_sag_m = 0;     ///< mean node distance |x_s_i - X_i| over all nodes
+  double total_mass_kg = 0;  ///< density x rest volume of X
   /// Forward check (NaN when not run: disabled, failed, or no load): largest and mean node
   /// distance between x_s and the static solution from rest X, and whether that solve converged.
   /// A failed forward solve is named in `message`, never thrown.
@@ -129,7 +129,7 @@ struct RestShapeResult {
   /// The forward check's static solution (3n, m): what a simulation from the estimated rest shape
   /// settles into, to compare with x_s node by node. Empty when the check did not run or failed.
   Eigen::VectorXd forward_position_m;
-  std::string message;          ///< one line: how the iteration ended
+  std::string message;  ///< one line: how the iteration ended
 };
 
 /// Estimates the rest shape from the observed static shape `static_shape_m` (3n, every node).

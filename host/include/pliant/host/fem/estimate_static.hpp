@@ -104,10 +104,10 @@ struct YoungsModulusOptions {
   /// Start of the fit (Pa); 0: the problem's material value (recording's youngs_modulus if
   /// declared, else FemRecordingDefaults::youngs_modulus_pa).
   double initial_youngs_modulus_pa = 0;
-  double lower_youngs_modulus_pa = 10;     ///< Pa, > 0, below the start
-  double upper_youngs_modulus_pa = 1e11;   ///< Pa, above the start
-  double position_noise_m = 0;  ///< per coordinate; 0: estimated (see Whitening above)
-  double force_noise_n = 0;     ///< per axis; 0: estimated
+  double lower_youngs_modulus_pa = 10;    ///< Pa, > 0, below the start
+  double upper_youngs_modulus_pa = 1e11;  ///< Pa, above the start
+  double position_noise_m = 0;            ///< per coordinate; 0: estimated (see Whitening above)
+  double force_noise_n = 0;               ///< per axis; 0: estimated
   /// Fit settings. The default loss is Huber with automatic scale (robust to a few gross tracking
   /// outliers); use RobustLoss::cauchy for heavy outliers. difference_step is relative (log E).
   FitOptions fit = default_modulus_fit_options();
@@ -135,18 +135,18 @@ struct YoungsModulusOptions {
 
 /// One row per used frame, at the solution.
 struct StaticFrameRow {
-  int frame = 0;        ///< index into FemRecordingProblem::frames
+  int frame = 0;  ///< index into FemRecordingProblem::frames
   double time_s = 0;
   /// Relative shortening of the distance between the centroid of applied_to and the centroid of
   /// the other constrained nodes (reaction estimator; NaN when not computable, 0 otherwise).
   double nominal_strain = 0;
-  Eigen::Vector3d measured_force_n = Eigen::Vector3d::Zero();   ///< the wrench (tool on object)
+  Eigen::Vector3d measured_force_n = Eigen::Vector3d::Zero();  ///< the wrench (tool on object)
   /// Force estimator: the force applied (= measured). Reaction estimator: the simulated tool force
   /// (sum of reactions over the reaction nodes, plus the fitted offset if any).
   Eigen::Vector3d simulated_force_n = Eigen::Vector3d::Zero();
-  int position_count = 0;        ///< tracked free nodes compared in this frame
+  int position_count = 0;                                            ///< tracked free nodes compared in this frame
   double position_rms_m = std::numeric_limits<double>::quiet_NaN();  ///< rms |sim - tracked| (3D)
-  int newton_iterations = 0;     ///< of the static solve that produced this solution
+  int newton_iterations = 0;  ///< of the static solve that produced this solution
   /// The static solution itself (3n node positions, m), only with
   /// YoungsModulusOptions::keep_frame_positions (empty otherwise): for residual maps and
   /// visualisation of the fitted model.
@@ -154,28 +154,28 @@ struct StaticFrameRow {
 };
 
 struct YoungsModulusEstimate {
-  bool converged = false;          ///< see "Converged" above
+  bool converged = false;  ///< see "Converged" above
   double youngs_modulus_pa = 0;
   double standard_deviation_pa = std::numeric_limits<double>::quiet_NaN();  ///< 1 sigma, from the fit
   double initial_youngs_modulus_pa = 0;
-  double rescaled_start_pa = 0;    ///< where the optimiser started (= initial without rescale_start)
+  double rescaled_start_pa = 0;  ///< where the optimiser started (= initial without rescale_start)
   double position_noise_m = std::numeric_limits<double>::quiet_NaN();  ///< whitening used or estimated
   double force_noise_n = std::numeric_limits<double>::quiet_NaN();     ///< whitening used or estimated
   double position_rms_m = std::numeric_limits<double>::quiet_NaN();    ///< over every compared coordinate x3
   double force_rms_n = std::numeric_limits<double>::quiet_NaN();       ///< per fitted axis, reaction fit
-  Eigen::Vector3d force_offset_n = Eigen::Vector3d::Zero();  ///< reaction fit with fit_force_offset
-  double residual_sigma = 0;       ///< FitResult::residual_sigma (about 1 when whitening is right)
+  Eigen::Vector3d force_offset_n = Eigen::Vector3d::Zero();            ///< reaction fit with fit_force_offset
+  double residual_sigma = 0;  ///< FitResult::residual_sigma (about 1 when whitening is right)
   int residual_count = 0;
   int frames_used = 0;
-  int iterations = 0;              ///< optimiser iterations over all passes (and stages)
-  int evaluations = 0;             ///< solve sequences: fit evaluations, start rescaling, final table
+  int iterations = 0;   ///< optimiser iterations over all passes (and stages)
+  int evaluations = 0;  ///< solve sequences: fit evaluations, start rescaling, final table
   long static_solves = 0;
-  long newton_iterations = 0;      ///< over every static solve
+  long newton_iterations = 0;  ///< over every static solve
   double wall_s = 0;
-  double cpu_s = 0;                ///< process CPU time (all threads)
+  double cpu_s = 0;  ///< process CPU time (all threads)
   std::vector<StaticFrameRow> frames;
-  FitResult fit;                   ///< the (last stage's) optimiser result
-  std::string message;             ///< one line: what was fitted, to which data, the outcome
+  FitResult fit;        ///< the (last stage's) optimiser result
+  std::string message;  ///< one line: what was fitted, to which data, the outcome
 };
 
 /// (a) Force-driven, as STEPE. Per used frame (frames with a wrench), the measured wrench is
@@ -240,7 +240,7 @@ enum class ContactModel {
 struct ContactForceOptions {
   ContactModel contact = ContactModel::spread_force;
   LoadSpread load_spread = LoadSpread::uniform_traction;  ///< spread_force: how F is shared
-  FrameSelection frames;  ///< frames without a wrench are estimated too (no comparison)
+  FrameSelection frames;                                  ///< frames without a wrench are estimated too (no comparison)
   /// spread_force: bound on each force component (N); 0: E x L^2 with L the rest bounding-box
   /// diagonal (a force that would deform the whole body by about its own size).
   double force_bound_n = 0;
@@ -257,7 +257,7 @@ struct ContactForceFrame {
   int frame = 0;
   double time_s = 0;
   bool converged = false;
-  Eigen::Vector3d estimated_force_n = Eigen::Vector3d::Zero();   ///< force on the object
+  Eigen::Vector3d estimated_force_n = Eigen::Vector3d::Zero();  ///< force on the object
   /// 1 sigma per component from the fit (rigid_probe: propagated through dF/du).
   Eigen::Vector3d standard_deviation_n = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
   /// rigid_probe: the probe's estimated travel from rest (m); NaN for spread_force.

@@ -39,10 +39,10 @@ struct FemMaterial {
   /// Pa, > 0. Used for every element when the mesh carries no per-tetrahedron values; ignored
   /// (may stay 0) when TetMesh::youngs_modulus is given.
   double youngs_modulus_pa = 0;
-  double poisson_ratio = 0.3;       ///< dimensionless, in (-1, 0.5)
-  double density_kg_m3 = 1000;      ///< kg/m^3, > 0
-  double rayleigh_alpha = 0;        ///< 1/s, >= 0: mass-proportional damping
-  double rayleigh_beta = 0;         ///< s, >= 0: stiffness-proportional damping
+  double poisson_ratio = 0.3;                              ///< dimensionless, in (-1, 0.5)
+  double density_kg_m3 = 1000;                             ///< kg/m^3, > 0
+  double rayleigh_alpha = 0;                               ///< 1/s, >= 0: mass-proportional damping
+  double rayleigh_beta = 0;                                ///< s, >= 0: stiffness-proportional damping
   Eigen::Vector3d gravity_m_s2 = Eigen::Vector3d::Zero();  ///< body acceleration (finite)
 };
 
@@ -96,7 +96,7 @@ class FemModel {
 
   /// Setters. Each validates like the constructor and throws std::invalid_argument, leaving the
   /// model unchanged. O(m) at most; the sparsity pattern never changes.
-  void set_youngs_modulus(double youngs_modulus_pa);                          ///< every element
+  void set_youngs_modulus(double youngs_modulus_pa);                                 ///< every element
   void set_youngs_modulus(const Eigen::Ref<const Eigen::VectorXd>& per_element_pa);  ///< m entries
   void set_poisson_ratio(double poisson_ratio);
   void set_density(double density_kg_m3);  ///< recomputes the lumped masses

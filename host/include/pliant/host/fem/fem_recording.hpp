@@ -21,8 +21,8 @@ namespace pliant::host::fem {
 /// What the recording does not say and the FEM needs. Values in recording.json "material"
 /// always win over these.
 struct FemRecordingDefaults {
-  double poisson_ratio = 0.45;   ///< used when material.poisson_ratio is absent
-  double density_kg_m3 = 1000;   ///< used when material.density is absent
+  double poisson_ratio = 0.45;  ///< used when material.poisson_ratio is absent
+  double density_kg_m3 = 1000;  ///< used when material.density is absent
   /// Young's modulus the model starts from (Pa) when material.youngs_modulus is absent and the
   /// mesh has no per-element values; estimators replace it.
   double youngs_modulus_pa = 1e5;
@@ -37,20 +37,20 @@ struct FemFrame {
   /// node's observation; when the driven node is unobserved in this frame, linearly
   /// interpolated in time between its nearest observed frames (held at the ends).
   Eigen::VectorXd driven_position_m;
-  bool has_wrench = false;              ///< a wrench sample covers this time
-  Eigen::Vector3d wrench_force_n = Eigen::Vector3d::Zero();   ///< interpolated; tool on object
+  bool has_wrench = false;                                   ///< a wrench sample covers this time
+  Eigen::Vector3d wrench_force_n = Eigen::Vector3d::Zero();  ///< interpolated; tool on object
   Eigen::Vector3d wrench_torque_nm = Eigen::Vector3d::Zero();
 };
 
 struct FemRecordingProblem {
   std::string name;
   TetMesh mesh;
-  FemMaterial material;            ///< from recording.material + defaults (gravity included)
-  bool gravity_declared = false;   ///< the recording gave gravity (else zero is assumed)
+  FemMaterial material;           ///< from recording.material + defaults (gravity included)
+  bool gravity_declared = false;  ///< the recording gave gravity (else zero is assumed)
   /// Names of material parameters the recording declared (estimators keep them fixed).
   std::vector<std::string> known_parameters;
-  std::vector<int> fixed_nodes;    ///< ascending
-  std::vector<int> applied_to;     ///< wrench.applied_to, ascending (empty without a wrench)
+  std::vector<int> fixed_nodes;  ///< ascending
+  std::vector<int> applied_to;   ///< wrench.applied_to, ascending (empty without a wrench)
   std::vector<FemFrame> frames;
   bool has_wrench() const { return !applied_to.empty(); }
   bool is_known(const std::string& parameter) const;
@@ -60,8 +60,7 @@ struct FemRecordingProblem {
 /// has no mesh, or a driven node is never observed inside one of its windows. Wrench samples
 /// are interpolated linearly onto frame times; frames outside the wrench's time span have
 /// has_wrench = false.
-FemRecordingProblem fem_problem_from_recording(const Recording& recording,
-                                               const FemRecordingDefaults& defaults = {});
+FemRecordingProblem fem_problem_from_recording(const Recording& recording, const FemRecordingDefaults& defaults = {});
 
 /// The frames with time_s <= last_time_s (at least the first frame is kept).
 void keep_frames_until(FemRecordingProblem& problem, double last_time_s);

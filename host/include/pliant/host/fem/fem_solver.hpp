@@ -99,8 +99,8 @@ struct FemStepOptions {
 };
 
 struct FemStepReport {
-  int newton_iterations = 0;      ///< total over the substeps
-  double last_correction_m = 0;   ///< largest |dx| of the last Newton iteration
+  int newton_iterations = 0;     ///< total over the substeps
+  double last_correction_m = 0;  ///< largest |dx| of the last Newton iteration
 };
 
 struct FemStaticOptions {
@@ -115,10 +115,10 @@ struct FemStaticOptions {
 struct FemStaticResult {
   bool converged = false;
   int iterations = 0;
-  double residual_n = 0;          ///< largest |f_int + f_ext + M g| over free DOFs at the end
-  double last_update_m = 0;       ///< largest position update of the last iteration
-  Eigen::VectorXd position_m;     ///< 3n equilibrium positions
-  Eigen::VectorXd reaction_n;     ///< 3n, non-zero at constrained nodes only
+  double residual_n = 0;       ///< largest |f_int + f_ext + M g| over free DOFs at the end
+  double last_update_m = 0;    ///< largest position update of the last iteration
+  Eigen::VectorXd position_m;  ///< 3n equilibrium positions
+  Eigen::VectorXd reaction_n;  ///< 3n, non-zero at constrained nodes only
 };
 
 class FemSolver {

@@ -33,8 +33,7 @@ struct FitParameter {
 /// then uses the residual scatter instead (see FitResult::residual_sigma). Return false when the
 /// model cannot be evaluated at these values (solver failure, inverted elements): the optimiser
 /// treats that step as rejected and shrinks its trust region.
-using ResidualFunction =
-    std::function<bool(const std::vector<double>& values, std::vector<double>& residuals)>;
+using ResidualFunction = std::function<bool(const std::vector<double>& values, std::vector<double>& residuals)>;
 
 enum class RobustLoss {
   none,    ///< plain least squares
@@ -48,7 +47,7 @@ struct FitOptions {
   /// first pass without the loss, then robust passes (at most four) with the bend at 2.5 x the
   /// robust (MAD) residual scatter of the previous solution, until that scale changes < 5 %.
   double loss_scale = 0.0;
-  int max_iterations = 60;          ///< per pass
+  int max_iterations = 60;            ///< per pass
   double function_tolerance = 1e-10;  ///< relative cost decrease that ends a pass
   double parameter_tolerance = 1e-9;  ///< relative step that ends a pass
   /// Central-difference step for the Jacobian: in log space for log-scale parameters (a
@@ -77,11 +76,11 @@ struct FitResult {
   /// sqrt(sum w r^2 / (m - n)): the scatter of the residuals about the fit, in residual units;
   /// near 1 when residuals were whitened correctly and the model fits.
   double residual_sigma = 0.0;
-  int iterations = 0;           ///< over all passes
-  int evaluations = 0;          ///< residual function calls, including Jacobian differences
-  bool converged = false;       ///< a tolerance was met (not the iteration limit)
-  std::vector<bool> at_bound;   ///< per parameter: ended within 1e-6 (relative) of a bound
-  std::string message;          ///< the optimiser's own summary line
+  int iterations = 0;          ///< over all passes
+  int evaluations = 0;         ///< residual function calls, including Jacobian differences
+  bool converged = false;      ///< a tolerance was met (not the iteration limit)
+  std::vector<bool> at_bound;  ///< per parameter: ended within 1e-6 (relative) of a bound
+  std::string message;         ///< the optimiser's own summary line
 };
 
 /// Minimises the (robustified) sum of squared residuals over the bounded parameters.

@@ -53,9 +53,9 @@ class MeshError : public std::runtime_error {
 /// What a reader changed or noticed while reading a mesh. Readers take an optional pointer to
 /// one; the report is reset by the reader before it is filled.
 struct MeshReadReport {
-  int reoriented_tets = 0;    ///< tetrahedra whose last two points were swapped (see top)
-  int unused_points = 0;      ///< points kept although no tetrahedron uses them
-  int skipped_elements = 0;   ///< MSH points/lines/surface elements skipped
+  int reoriented_tets = 0;            ///< tetrahedra whose last two points were swapped (see top)
+  int unused_points = 0;              ///< points kept although no tetrahedron uses them
+  int skipped_elements = 0;           ///< MSH points/lines/surface elements skipped
   std::vector<std::string> warnings;  ///< one line each, naming the file
 };
 
@@ -86,8 +86,7 @@ std::string read_mesh_file(const std::string& path);
 /// node coordinates are accepted and ignored. $Nodes must come before $Elements, both exactly
 /// once. Other versions (2.0-2.1 and 3.0 are not written by gmsh; 4.0 has a different layout,
 /// binary 2.2) are refused with the version in the message.
-TetMesh parse_msh(std::string_view text, const std::string& file_label,
-                  MeshReadReport* report = nullptr);
+TetMesh parse_msh(std::string_view text, const std::string& file_label, MeshReadReport* report = nullptr);
 
 /// Points of a TetGen .node file and the number its first point carries (0 or 1), which the
 /// .ele file's point references use as well.
@@ -105,8 +104,8 @@ TetGenNodes parse_tetgen_node(std::string_view text, const std::string& file_lab
 /// TetGen .ele: "<count> 4 <attributes>" then "<index> a b c d [attributes...]" per line, the
 /// point references numbered as nodes.first_index says. Element indices are not checked beyond
 /// being integers. Region attributes are ignored. Returns the mesh with nodes.points moved in.
-TetMesh parse_tetgen_ele(std::string_view text, const std::string& file_label,
-                         TetGenNodes nodes, MeshReadReport* report = nullptr);
+TetMesh parse_tetgen_ele(std::string_view text, const std::string& file_label, TetGenNodes nodes,
+                         MeshReadReport* report = nullptr);
 
 // ------------------------------------------------------------------------------------------
 // Writers. Numbers use the shortest text that reads back bit for bit. Each throws MeshError when
@@ -118,8 +117,7 @@ TetMesh parse_tetgen_ele(std::string_view text, const std::string& file_label,
 void write_msh(const TetMesh& mesh, std::ostream& out);
 
 /// TetGen .node ("n 3 0 0") and .ele ("m 4 0"), numbered from `first_index` (0 or 1).
-void write_tetgen(const TetMesh& mesh, std::ostream& node_out, std::ostream& ele_out,
-                  int first_index = 1);
+void write_tetgen(const TetMesh& mesh, std::ostream& node_out, std::ostream& ele_out, int first_index = 1);
 
 // ------------------------------------------------------------------------------------------
 // Geometry
@@ -133,7 +131,6 @@ double tet_mesh_volume(const TetMesh& mesh);
 /// finite points, youngs_modulus empty or one per tetrahedron, then orientation fixed and
 /// degenerate tetrahedra rejected as described at the top of this file. Messages name
 /// `file_label` and the 0-based tetrahedron index. Throws MeshError.
-void orient_and_check_tet_mesh(TetMesh& mesh, const std::string& file_label,
-                               MeshReadReport* report = nullptr);
+void orient_and_check_tet_mesh(TetMesh& mesh, const std::string& file_label, MeshReadReport* report = nullptr);
 
 }  // namespace pliant::host

@@ -35,8 +35,8 @@ struct VtkNamedArray {
 
 /// One frame. Every value must be finite (ParaView's readers do not accept NaN text).
 struct VtkSeriesFrame {
-  double time_s = 0.0;              ///< strictly increasing across frames
-  std::vector<double> positions;    ///< 3 * point_count: current x y z of every mesh point
+  double time_s = 0.0;                       ///< strictly increasing across frames
+  std::vector<double> positions;             ///< 3 * point_count: current x y z of every mesh point
   std::vector<VtkNamedArray> point_vectors;  ///< each 3 * point_count (e.g. displacement, m)
   std::vector<VtkNamedArray> cell_scalars;   ///< each tet_count (e.g. von_mises_pa)
 };

@@ -80,10 +80,10 @@ struct StepeScenarioOptions {
   bool equal_nodal_shares = false;
   /// Probe direction: -z tilted toward +x by this angle (deg), STEPE's "tilted" rows.
   double tilt_deg = 0;
-  double peak_force_n = 1000;        ///< force control: about 1.5 cm probe travel
-  double depth_m = 0.02;             ///< displacement control: travel along the probe direction
-  int ramp_frames = 3;               ///< >= 1
-  int hold_frames = 0;               ///< >= 0
+  double peak_force_n = 1000;  ///< force control: about 1.5 cm probe travel
+  double depth_m = 0.02;       ///< displacement control: travel along the probe direction
+  int ramp_frames = 3;         ///< >= 1
+  int hold_frames = 0;         ///< >= 0
   double frame_interval_s = 1.0;
   double position_noise_m = 0.5e-3;  ///< depth-camera tracking noise, per coordinate
   double force_noise_n = 0.2;        ///< force sensor noise, per axis

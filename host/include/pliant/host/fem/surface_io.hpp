@@ -19,8 +19,8 @@ namespace pliant::host {
 /// A triangle soup or mesh: point i is row i of `points`; triangles hold 0-based point indices,
 /// three per triangle. Readers return distinct indices within each triangle.
 struct TriangleSurface {
-  std::vector<double> points;   ///< 3 * point_count, x y z per point
-  std::vector<int> triangles;   ///< 3 * triangle_count point indices
+  std::vector<double> points;  ///< 3 * point_count, x y z per point
+  std::vector<int> triangles;  ///< 3 * triangle_count point indices
   int point_count() const { return static_cast<int>(points.size() / 3); }
   int triangle_count() const { return static_cast<int>(triangles.size() / 3); }
 };
@@ -58,8 +58,8 @@ TriangleSurface read_surface(const std::string& path, std::vector<std::string>* 
 // Checks
 
 struct SurfaceMergeResult {
-  int points_removed = 0;      ///< merged into an earlier point, or used by no triangle
-  int triangles_dropped = 0;   ///< collapsed: two of their points merged
+  int points_removed = 0;     ///< merged into an earlier point, or used by no triangle
+  int triangles_dropped = 0;  ///< collapsed: two of their points merged
 };
 
 /// Merges points closer than `relative_tolerance` times the diagonal of the points' bounding
@@ -73,10 +73,10 @@ SurfaceMergeResult merge_duplicate_vertices(TriangleSurface& surface, const std:
 
 /// Edge census of a surface: an edge is a pair of points joined by a triangle side.
 struct SurfaceEdgeCheck {
-  int edges = 0;                ///< distinct undirected edges
-  int boundary_edges = 0;       ///< used by exactly one triangle (a hole)
-  int nonmanifold_edges = 0;    ///< used by three or more triangles
-  int misoriented_edges = 0;    ///< used twice in the same direction (neighbours wound apart)
+  int edges = 0;                     ///< distinct undirected edges
+  int boundary_edges = 0;            ///< used by exactly one triangle (a hole)
+  int nonmanifold_edges = 0;         ///< used by three or more triangles
+  int misoriented_edges = 0;         ///< used twice in the same direction (neighbours wound apart)
   int first_bad_edge[2] = {-1, -1};  ///< points of the first boundary or non-manifold edge
   bool closed() const { return boundary_edges == 0 && nonmanifold_edges == 0; }
 };

@@ -52,8 +52,7 @@ std::string tetgen_switches(const TetrahedralizeOptions& options);
 /// whose points start with the surface points that the mesh uses (in their order; a point TetGen
 /// did not use is dropped) followed by the points TetGen added; every tetrahedron positively
 /// oriented (mesh_io.hpp), no unused points, youngs_modulus empty. Errors name `file_label`.
-TetMesh tetrahedralize(const TriangleSurface& surface,
-                       const TetrahedralizeOptions& options = TetrahedralizeOptions(),
+TetMesh tetrahedralize(const TriangleSurface& surface, const TetrahedralizeOptions& options = TetrahedralizeOptions(),
                        const std::string& file_label = "surface");
 
 }  // namespace pliant::host

@@ -38,7 +38,7 @@ struct ReplayOptions {
   std::string fault_script;  ///< script text (empty: no faults)
   bool estimate = true;      ///< run the online msm_beta estimate on the particle frames
   double msm_alpha = 1.0;
-  int candidates = 21;       ///< online estimator grid size (>= 3)
+  int candidates = 21;  ///< online estimator grid size (>= 3)
 };
 
 enum class ReplayDevice : std::uint8_t { particles, wrench, gripper };
@@ -47,8 +47,8 @@ const char* replay_device_name(ReplayDevice device) noexcept;  ///< "particles",
 /// One read that delivered a sample, or whose status changed to or from a failure.
 struct ReplayEvent {
   ReplayDevice device = ReplayDevice::particles;
-  hal::HalStatus status = hal::HalStatus::ok;  ///< ok: a sample; else the failure that started
-  double now_s = 0;                            ///< replay clock at the read, from 0
+  hal::HalStatus status = hal::HalStatus::ok;     ///< ok: a sample; else the failure that started
+  double now_s = 0;                               ///< replay clock at the read, from 0
   const hal::ParticleFrame* particles = nullptr;  ///< set for delivered particle frames
   const hal::WrenchReading* wrench = nullptr;
   const hal::GripperReading* gripper = nullptr;
@@ -68,9 +68,9 @@ struct ReplaySummary {
   OnlineDeformabilityEstimate estimate;
   std::uint32_t estimator_rejected_frames = 0;
   std::uint32_t estimator_empty_frames = 0;
-  int skipped_rows = 0;       ///< wrench/gripper rows whose time did not increase
-  double duration_s = 0;      ///< replay clock at the end
-  bool interrupted = false;   ///< stopped by the `keep_going` callback
+  int skipped_rows = 0;      ///< wrench/gripper rows whose time did not increase
+  double duration_s = 0;     ///< replay clock at the end
+  bool interrupted = false;  ///< stopped by the `keep_going` callback
 };
 
 /// Plays `recording` back. `on_event` sees every event as it happens; `keep_going` is asked

@@ -52,7 +52,7 @@ struct LibcameraCameraConfig {
   int width = 0;          ///< requested width, px, 0..16384 (0: the pipeline's default for the role)
   int height = 0;         ///< requested height, px, 0..16384 (0: default)
   hal::PixelFormat format = hal::PixelFormat::rgb8;  ///< delivered pixel format
-  int buffer_count = 4;   ///< 2..16 requested (libcamera may adjust)
+  int buffer_count = 4;                              ///< 2..16 requested (libcamera may adjust)
   LibcameraRole role = LibcameraRole::video_recording;
 };
 

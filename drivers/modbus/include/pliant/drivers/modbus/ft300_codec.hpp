@@ -1,6 +1,6 @@
 // pliant modbus driver: the Robotiq FT 300 wrist force/torque sensor as pure codecs (no I/O).
 //
-// Facts (HARDWARE.md 2.2; Robotiq's rq_sensor_com.cpp, TRI robotiq_ft_driver):
+// Facts (Robotiq's rq_sensor_com.cpp, TRI robotiq_ft_driver; docs/drivers/modbus.md):
 //   link       RS-485 Modbus RTU, 19200 baud 8N1, slave 9
 //   polling    holding registers 180..185 (FC03) = Fx Fy Fz Mx My Mz as int16:
 //              force = counts / 100 N, torque = counts / 1000 N m
@@ -21,10 +21,10 @@
 namespace pliant::drivers::modbus::ft300 {
 
 inline constexpr int kDefaultSlaveId = 9;
-inline constexpr int kDefaultBaud = 19200;           ///< 8N1
-inline constexpr int kWrenchRegister = 180;          ///< Fx; Fy..Mz follow (FC03)
+inline constexpr int kDefaultBaud = 19200;   ///< 8N1
+inline constexpr int kWrenchRegister = 180;  ///< Fx; Fy..Mz follow (FC03)
 inline constexpr int kWrenchRegisterCount = 6;
-inline constexpr int kStreamControlRegister = 410;   ///< FC16 kStreamStart here starts the stream
+inline constexpr int kStreamControlRegister = 410;  ///< FC16 kStreamStart here starts the stream
 inline constexpr std::uint16_t kStreamStart = 0x0200;
 inline constexpr double kForceCountsPerN = 100.0;
 inline constexpr double kTorqueCountsPerNm = 1000.0;

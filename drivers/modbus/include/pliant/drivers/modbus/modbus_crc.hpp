@@ -1,5 +1,5 @@
 // pliant modbus driver: the Modbus RTU CRC-16, shared by the RTU frames this driver builds
-// itself (the FT 300 stream start request) and the FT 300 stream frames (HARDWARE.md 2.2).
+// itself (the FT 300 stream start request) and the FT 300 stream frames (docs/drivers/modbus.md).
 //
 // CRC-16/MODBUS: reflected polynomial 0xA001 (0x8005), initial value 0xFFFF, no final XOR.
 // On the wire the CRC follows the covered bytes low byte first. Check value: the CRC of the

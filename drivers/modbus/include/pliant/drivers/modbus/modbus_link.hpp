@@ -53,12 +53,12 @@ struct ModbusLinkConfig {
   int data_bits = 8;                    ///< 5..8
   int stop_bits = 1;                    ///< 1 or 2
   // TCP
-  std::string host = "127.0.0.1";       ///< IPv4 address (dotted quad; no name lookup)
-  int port = 502;                       ///< 1..65535
+  std::string host = "127.0.0.1";  ///< IPv4 address (dotted quad; no name lookup)
+  int port = 502;                  ///< 1..65535
   // Both
-  int slave_id = 9;                     ///< 0..247 (the unit identifier over TCP)
-  double response_timeout_s = 0.02;     ///< whole-response budget per transaction, (0, 10] s
-  double reconnect_interval_s = 0.1;    ///< minimum time between reconnection attempts, >= 0
+  int slave_id = 9;                   ///< 0..247 (the unit identifier over TCP)
+  double response_timeout_s = 0.02;   ///< whole-response budget per transaction, (0, 10] s
+  double reconnect_interval_s = 0.1;  ///< minimum time between reconnection attempts, >= 0
 };
 
 /// invalid_argument when a field breaks its documented range, else ok.

@@ -1,6 +1,7 @@
 // pliant modbus driver: the Robotiq 2F-85 / 2F-140 register map as pure functions (no I/O).
 //
-// Register map (HARDWARE.md 2.1; Robotiq 2F-85 & 2F-140 manual section 4):
+// Register map (Robotiq 2F-85 & 2F-140 Instruction Manual, section 4; sources per fact in
+// docs/drivers/modbus.md, "Device facts we rely on"):
 //   command  3 holding registers at 0x03E8, written with FC16 ("robot output")
 //   status   3 registers at 0x07D0, read with FC04 (current manuals) or FC03 (2016 manual,
 //            older drivers) ("robot input")
@@ -56,13 +57,13 @@ inline constexpr int kCommandRegister = 0x03e8;  ///< first command register (FC
 inline constexpr int kStatusRegister = 0x07d0;   ///< first status register (FC04, FC03)
 inline constexpr int kRegisterCount = 3;         ///< both blocks are 3 registers (6 bytes)
 inline constexpr int kDefaultSlaveId = 9;
-inline constexpr int kDefaultBaud = 115200;      ///< 8N1
+inline constexpr int kDefaultBaud = 115200;  ///< 8N1
 
 // Action request bits (command byte 0).
-inline constexpr std::uint8_t kActionActivate = 1u << 0;        ///< rACT
-inline constexpr std::uint8_t kActionGoTo = 1u << 3;            ///< rGTO
-inline constexpr std::uint8_t kActionAutoRelease = 1u << 4;     ///< rATR
-inline constexpr std::uint8_t kActionReleaseDirection = 1u << 5; ///< rARD
+inline constexpr std::uint8_t kActionActivate = 1u << 0;          ///< rACT
+inline constexpr std::uint8_t kActionGoTo = 1u << 3;              ///< rGTO
+inline constexpr std::uint8_t kActionAutoRelease = 1u << 4;       ///< rATR
+inline constexpr std::uint8_t kActionReleaseDirection = 1u << 5;  ///< rARD
 
 // gSTA and gOBJ values.
 inline constexpr std::uint8_t kStaReset = 0;
@@ -90,12 +91,12 @@ struct Command {
 
 /// One status block, field by field.
 struct Status {
-  std::uint8_t gact = 0;  ///< 0/1
-  std::uint8_t ggto = 0;  ///< 0/1
-  std::uint8_t gsta = 0;  ///< 0..3
-  std::uint8_t gobj = 0;  ///< 0..3
-  std::uint8_t gflt = 0;  ///< 0..15
-  std::uint8_t kflt = 0;  ///< 0..15
+  std::uint8_t gact = 0;              ///< 0/1
+  std::uint8_t ggto = 0;              ///< 0/1
+  std::uint8_t gsta = 0;              ///< 0..3
+  std::uint8_t gobj = 0;              ///< 0..3
+  std::uint8_t gflt = 0;              ///< 0..15
+  std::uint8_t kflt = 0;              ///< 0..15
   std::uint8_t position_request = 0;  ///< gPR
   std::uint8_t position = 0;          ///< gPO
   std::uint8_t current = 0;           ///< gCU, ~10 mA per count

@@ -1,5 +1,5 @@
 // pliant modbus driver: a Robotiq FT 300 wrist sensor as a pliant::hal::ForceTorqueSensor.
-// Protocol facts and scales: ft300_codec.hpp (HARDWARE.md 2.2).
+// Protocol facts and scales: ft300_codec.hpp (sources: docs/drivers/modbus.md).
 //
 // Two modes:
 //   polling  every read() is one FC03 transaction of registers 180..185 over the ModbusLink
@@ -21,8 +21,8 @@
 //            disconnected: the port is closed, reopened on a later read (at most once per
 //            link.reconnect_interval_s) and the start request is sent again. stop() writes the 50-byte jam signal once
 //            (non-blocking); the sensor may need it repeated, and Modbus on that port answers
-//            only ~100 ms after the stream stopped (HARDWARE.md 2.2) - this driver never mixes
-//            the two modes on one port.
+//            only ~100 ms after the stream stopped (docs/drivers/modbus.md) - this driver
+//            never mixes the two modes on one port.
 //
 // Samples: wrench minus the bias (request_tare() takes the next sample's raw wrench as the
 // bias; cleared by configure), stamped with the clock time of the read that delivered it. Status
@@ -51,8 +51,8 @@ struct RobotiqFt300Config {
   /// Polling: the Modbus link. Stream: device, baud, slave_id and reconnect_interval_s are used
   /// (transport must be rtu). Default baud here is the FT 300's 19200.
   ModbusLinkConfig link = default_link();
-  double min_poll_period_s = 0.0;            ///< polling, >= 0
-  double stream_timeout_s = 0.16;            ///< stream: no valid frame this long -> timeout, > 0
+  double min_poll_period_s = 0.0;               ///< polling, >= 0
+  double stream_timeout_s = 0.16;               ///< stream: no valid frame this long -> timeout, > 0
   std::size_t max_stream_bytes_per_read = 512;  ///< stream, 16..65536
   /// The FT 300's link defaults: RTU, /dev/ttyUSB0, 19200 8N1, slave 9, 20 ms.
   static ModbusLinkConfig default_link() {

@@ -9,10 +9,10 @@
 //              `activation`: if_needed - an already activated gripper is used as it is, else the
 //              activation sequence begins; always - the sequence always begins; never - nothing
 //              is written (the application activates the gripper itself).
-//              Activation sequence (HARDWARE.md 2.1): write {0,0,0} (reset), wait reset_hold_s on
-//              the clock, write rACT = 1, then the gripper reports gSTA = 3. The waits are not
-//              spent inside a call: later read() calls advance the sequence. The fingers MOVE
-//              during activation (they open and close to calibrate).
+//              Activation sequence (Robotiq 2F manual; docs/drivers/modbus.md): write {0,0,0}
+//              (reset), wait reset_hold_s on the clock, write rACT = 1, then the gripper reports
+//              gSTA = 3. The waits are not spent inside a call: later read() calls advance the
+//              sequence. The fingers MOVE during activation (they open and close to calibrate).
 //              If gSTA = 3 does not come within activation_timeout_s the sequence starts over
 //              (counted in activation_retries). reactivate() restarts it at any time.
 //   read       one status transaction -> GripperReading (robotiq_2f_codec.hpp for the mapping);
@@ -61,8 +61,8 @@ enum class StatusRead : std::uint8_t { auto_detect, input_registers, holding_reg
 enum class ActivationPolicy : std::uint8_t { if_needed, always, never };
 
 struct RobotiqGripperConfig {
-  ModbusLinkConfig link;               ///< defaults: RTU /dev/ttyUSB0 115200 8N1, slave 9, 20 ms
-  robotiq2f::Scaling scaling;          ///< defaults: 2F-85
+  ModbusLinkConfig link;       ///< defaults: RTU /dev/ttyUSB0 115200 8N1, slave 9, 20 ms
+  robotiq2f::Scaling scaling;  ///< defaults: 2F-85
   StatusRead status_read = StatusRead::auto_detect;
   ActivationPolicy activation = ActivationPolicy::if_needed;
   double reset_hold_s = 1.0;           ///< wait between the reset and the activation write, >= 0

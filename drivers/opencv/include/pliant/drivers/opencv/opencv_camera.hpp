@@ -42,10 +42,16 @@
 // Devices (always live): the background thread grabs from configure to cleanup; frames grabbed
 // while inactive are discarded. read() delivers the newest frame not yet delivered (older ones
 // are skipped). Stamp = clock.now_s() minus the frame's age on std::chrono::steady_clock (the
-// grab time; the injected Clock is read only in the caller's thread). When a grab fails the
-// device is lost: read() returns disconnected, the thread reopens the device every
-// reconnect_interval_s and frames flow again after a successful reopen (counted as reconnects by
-// the HAL). stop() and cleanup() may wait for a grab in progress (OpenCV's V4L2 timeout).
+// time since the grab: a real duration, measured in real time because the grab thread must not
+// read the injected Clock, see "Clocks"). When a grab fails the device is lost: read() returns
+// disconnected and paces reopen attempts on the injected Clock: the first is due
+// reconnect_interval_s after the read that saw the loss, each next one reconnect_interval_s after
+// the read that asked for the previous one (later while that attempt still runs). A read at or
+// after that time asks the thread to reopen (read() itself never waits for the open; the attempt
+// runs in the thread, counted in reconnect_attempts); frames flow again after a successful reopen
+// (counted as reconnects by the HAL). No attempt is made while nothing reads (e.g. stopped): with
+// a ManualClock, advance it past the interval and read to see the next attempt. stop() and
+// cleanup() may wait for a grab in progress (OpenCV's V4L2 timeout).
 //
 // Sequence numbers: every frame the source yielded takes the next number, delivered or not, so
 // every drop (decode error, size mismatch, overrun, skip) is a gap the HAL counts as dropped
@@ -55,7 +61,16 @@
 // for a device), disconnected (no such V4L2 device, or it would not open), io_error (a file
 // that is missing, unreadable or not decodable; a first frame that cannot be decoded),
 // capacity_exceeded (frames too large for the ring), timeout (a non-blocking source gave no first
-// frame within 5 s). last_error() says why, in words.
+// frame within 5 s on the injected Clock, or within 5 s of real time: see "Clocks"). last_error()
+// says why, in words.
+//
+// Clocks: every timeout and interval (reconnect pacing, the first-frame wait of configure,
+// wait_buffered) is decided on the injected Clock, read only in the thread that drives the camera
+// (a ManualClock is not synchronised: the grab thread never reads it). A call that blocks
+// (configure's first-frame wait, wait_buffered) is also capped by the same span of real time,
+// because a ManualClock cannot move while its only thread waits here; with a SteadyClock both
+// limits coincide. Playback due times are on the injected Clock. std::chrono::steady_clock is read
+// only for those caps and for the age of a grabbed frame (a stamp correction, not a timeout).
 //
 // Real-time safety: read() in real_time and device modes is O(ring_frames), allocation-free,
 // noexcept and never blocks. configure, start, stop and cleanup are not real-time calls.
@@ -79,28 +94,28 @@ struct OpenCvCameraConfig {
   /// Device path or index, file path, or image pattern or directory (see the header comment).
   std::string location;
   hal::PixelFormat format = hal::PixelFormat::rgb8;  ///< delivered pixel format
-  int width = 0;     ///< devices: requested width, px, 0..16384 (0: default); files: ignored
-  int height = 0;    ///< devices: requested height, px, 0..16384 (0: default); files: ignored
-  double fps = 0;    ///< devices: requested rate; files: rate when the file has none; [0, 1000], Hz
+  int width = 0;   ///< devices: requested width, px, 0..16384 (0: default); files: ignored
+  int height = 0;  ///< devices: requested height, px, 0..16384 (0: default); files: ignored
+  double fps = 0;  ///< devices: requested rate; files: rate when the file has none; [0, 1000], Hz
   OpenCvPlayback playback = OpenCvPlayback::real_time;  ///< files only (devices: real_time)
-  int first_index = -1;    ///< image patterns: first index, >= 0 (-1: 0 or 1)
-  int ring_frames = 4;     ///< decoded frames buffered, 2..64
-  double reconnect_interval_s = 0.5;  ///< devices: wait between reopen attempts, (0, 60]
+  int first_index = -1;                                 ///< image patterns: first index, >= 0 (-1: 0 or 1)
+  int ring_frames = 4;                                  ///< decoded frames buffered, 2..64
+  double reconnect_interval_s = 0.5;  ///< devices: wait between reopen attempts, (0, 60], injected Clock
 };
 
 /// Driver-side counters and stream state (the HAL's DeviceCounters count the reads). Counts are
 /// monotonic from configure. Frames "dropped" here are never delivered.
 struct OpenCvCameraStats {
-  std::uint64_t decoded = 0;          ///< frames the source yielded (including the dropped ones)
-  std::uint64_t decode_errors = 0;    ///< frames that could not be decoded (dropped)
-  std::uint64_t size_mismatches = 0;  ///< frames of another size than the first (dropped)
-  std::uint64_t overruns = 0;         ///< devices: frames discarded because the ring was full (dropped)
-  std::uint64_t skipped = 0;          ///< frames passed over by read() for a newer one, or at a disconnect
+  std::uint64_t decoded = 0;             ///< frames the source yielded (including the dropped ones)
+  std::uint64_t decode_errors = 0;       ///< frames that could not be decoded (dropped)
+  std::uint64_t size_mismatches = 0;     ///< frames of another size than the first (dropped)
+  std::uint64_t overruns = 0;            ///< devices: frames discarded because the ring was full (dropped)
+  std::uint64_t skipped = 0;             ///< frames passed over by read() for a newer one, or at a disconnect
   std::uint64_t reconnect_attempts = 0;  ///< devices: reopen attempts after a loss
-  std::uint64_t reopened = 0;         ///< devices: successful reopens
-  bool end_of_stream = false;         ///< files: nothing more will be delivered
-  bool ended_early = false;           ///< the video ended before its announced frame count
-  bool device_lost = false;           ///< devices: unreachable now (reads return disconnected)
+  std::uint64_t reopened = 0;            ///< devices: successful reopens
+  bool end_of_stream = false;            ///< files: nothing more will be delivered
+  bool ended_early = false;              ///< the video ended before its announced frame count
+  bool device_lost = false;              ///< devices: unreachable now (reads return disconnected)
 };
 
 namespace opencv_detail {
@@ -131,9 +146,11 @@ class OpenCvCamera final : public hal::ColorCamera {
   double media_time_s() const noexcept { return media_time_s_; }
 
   /// Blocks until at least `frames` decoded frames wait in the ring (not counting the one held
-  /// by the last read), the stream ended, or `timeout_s` passed (steady clock); true unless it
-  /// timed out. Not a real-time call: for tests and offline replay of real_time mode, which
-  /// otherwise could find the decoder behind. Stepped mode: returns true at once.
+  /// by the last read), the stream ended, or `timeout_s` passed on the injected Clock or in real
+  /// time, whichever comes first (a ManualClock does not move during the wait, so real time is
+  /// the cap); true unless it timed out. Not a real-time call: for tests and offline replay of
+  /// real_time mode, which otherwise could find the decoder behind. Stepped mode: returns true
+  /// at once.
   bool wait_buffered(int frames, double timeout_s) const noexcept;
 
  protected:

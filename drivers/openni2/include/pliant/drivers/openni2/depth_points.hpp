@@ -49,7 +49,7 @@ struct DepthIntrinsics {
   double fy = std::numeric_limits<double>::quiet_NaN();  ///< focal length along v, px
   double cx = std::numeric_limits<double>::quiet_NaN();  ///< principal point column, px
   double cy = std::numeric_limits<double>::quiet_NaN();  ///< principal point row, px
-  int width = 0;   ///< the image size these are for, px
+  int width = 0;                                         ///< the image size these are for, px
   int height = 0;
 };
 
@@ -113,7 +113,7 @@ PointsResult depth_to_points(const hal::DepthFrame& frame, double* out_xyz, std:
 /// Copies a width x height depth image whose rows are stride_bytes apart (source size
 /// src_bytes) into a packed destination of dst_capacity samples. False, nothing copied, when
 /// the sizes do not fit (same rules as depth_to_points).
-bool copy_depth_image(const std::uint8_t* src, std::size_t src_bytes, int width, int height,
-                      std::size_t stride_bytes, std::uint16_t* dst, std::size_t dst_capacity) noexcept;
+bool copy_depth_image(const std::uint8_t* src, std::size_t src_bytes, int width, int height, std::size_t stride_bytes,
+                      std::uint16_t* dst, std::size_t dst_capacity) noexcept;
 
 }  // namespace pliant::drivers::openni2

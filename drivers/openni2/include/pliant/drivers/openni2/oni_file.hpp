@@ -80,12 +80,12 @@ inline constexpr std::uint32_t kOniNodeIr = 5;
 
 struct OniNodeInfo {
   std::uint32_t id = 0;
-  std::string name;              ///< e.g. "Depth1"
-  std::uint32_t type = 0;        ///< kOniNodeDepth, ...
-  std::string codec;             ///< four characters, e.g. "16zT", "JPEG", "NONE"
-  std::uint32_t frames_declared = 0;       ///< from the node-added (or data-begin) record
-  std::uint64_t seek_table_offset = 0;     ///< 0: none
-  std::uint32_t data_records = 0;          ///< new-data records in the file
+  std::string name;                               ///< e.g. "Depth1"
+  std::uint32_t type = 0;                         ///< kOniNodeDepth, ...
+  std::string codec;                              ///< four characters, e.g. "16zT", "JPEG", "NONE"
+  std::uint32_t frames_declared = 0;              ///< from the node-added (or data-begin) record
+  std::uint64_t seek_table_offset = 0;            ///< 0: none
+  std::uint32_t data_records = 0;                 ///< new-data records in the file
   std::uint32_t first_frame = 0, last_frame = 0;  ///< frame numbers of the first and last
   std::uint64_t first_timestamp_us = 0, last_timestamp_us = 0;
   std::uint64_t max_timestamp_step_us = 0;  ///< largest increase between consecutive records
@@ -98,9 +98,9 @@ struct OniFileInfo {
   std::uint64_t file_bytes = 0;
   std::uint64_t max_timestamp_us = 0;  ///< from the file header
   std::uint32_t max_node_id = 0;
-  std::uint64_t records = 0;           ///< records up to and including End
-  std::uint64_t trailing_bytes = 0;    ///< bytes after the End record (ignored by OpenNI2)
-  std::vector<OniNodeInfo> nodes;      ///< in the order they were first added
+  std::uint64_t records = 0;         ///< records up to and including End
+  std::uint64_t trailing_bytes = 0;  ///< bytes after the End record (ignored by OpenNI2)
+  std::vector<OniNodeInfo> nodes;    ///< in the order they were first added
   /// The first node of `type` with at least one data record, or nullptr.
   const OniNodeInfo* first_node_of_type(std::uint32_t type) const noexcept;
 };

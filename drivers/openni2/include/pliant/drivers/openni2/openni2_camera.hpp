@@ -1,6 +1,6 @@
 // pliant drivers/openni2: a hal::DepthCamera over OpenNI2 2.2 (Debian libopenni2-0), for depth
 // cameras of the PrimeSense family (Asus Xtion, Carmine; Kinect v1 with libfreenect's OpenNI2
-// driver) and for .oni recordings. HARDWARE.md section 3 has the library's facts.
+// driver) and for .oni recordings. docs/drivers/openni2.md lists the library's facts.
 //
 // Sources
 //   device     `location` is an OpenNI2 device URI (list_openni2_devices() shows them; Debian's
@@ -26,13 +26,21 @@
 // Playback of recordings
 //   stepped    OpenNI2's manual mode (speed -1): the player decodes a frame only when asked,
 //              so each read() delivers the next frame of the file, none skipped. This read
-//              waits for the player up to step_timeout_s (a blocking call, for offline replay
-//              and tests, not for a real-time loop). A read that times out ends the stream
-//              (ended_early): in this mode the player only ever waits for us.
+//              blocks until the player delivers, for what is left of step_timeout_s on the
+//              injected Clock since the read that began waiting for this frame, and never more
+//              than step_timeout_s of real time (a blocking call, for offline replay and tests,
+//              not for a real-time loop). When the wait ends without a frame: if step_timeout_s
+//              has passed on the injected Clock the stream ends (ended_early: in this mode the
+//              player only ever waits for us), else read() returns no_data. With a SteadyClock
+//              the read that times out ends the stream; a ManualClock does not move while the
+//              read blocks, so that read returns no_data and the stream ends at the first read
+//              after the caller advanced the clock past the deadline (that read only polls).
 //   real_time  the player paces frames by their timestamps (times playback_speed); read()
 //              never waits and delivers the newest frame (older unread ones are overwritten
-//              by OpenNI2: a sequence gap). If no frame arrives for stall_timeout_s (at least
-//              three times the file's largest frame interval) the stream ends (ended_early).
+//              by OpenNI2: a sequence gap). If no frame arrives for stall_timeout_s on the
+//              injected Clock (at least three times the file's largest frame interval; counted
+//              from start() or the last frame) the stream ends (ended_early), at the first read
+//              that finds nothing after that: with a ManualClock, when the caller advanced it.
 //   End of stream: after the frame with the recording's last frame number is taken from
 //   OpenNI2 (delivered, or rejected as damaged), or when OpenNI2 reports the end of the file
 //   with nothing left to read, read() returns no_data
@@ -76,6 +84,11 @@
 // stopped before destroying it. By then DummyDevice's thread is gone and libOniFile's player is
 // idle: it looks at its list only once every 10 ms, a window too short to have been hit in the
 // tests (the race cannot be closed from outside the library).
+// Clocks: the stream's timeouts (step_timeout_s, stall_timeout_s) are decided on the injected
+// Clock, read only in the calling thread (OpenNI2's threads never see it). Two waits are real
+// time on purpose, because they wait for OpenNI2's own threads, which run in real time: the
+// teardown grace (std::chrono::steady_clock) and stop()'s wait of at most 500 ms for
+// DummyDevice's first frame; neither decides anything about the stream.
 //
 // Real-time safety: read() on devices and real_time recordings never waits, copies one frame
 // (O(pixels)) and makes no allocation of its own (OpenNI2's internal threads allocate as they
@@ -103,17 +116,19 @@ enum class IntrinsicsSource : std::uint8_t { none, device_fov, configured };
 
 struct Openni2CameraConfig {
   Openni2Source source = Openni2Source::device;
-  std::string location = "any";  ///< device URI or "any"; recording: .oni path
+  std::string location = "any";                           ///< device URI or "any"; recording: .oni path
   Openni2Playback playback = Openni2Playback::real_time;  ///< recordings only
-  double playback_speed = 1.0;   ///< real_time recordings: (0, 16], 1 = as recorded
-  int width = 0;                 ///< devices: depth mode width, px, 0..kMaxDepthSide (0: current)
-  int height = 0;                ///< devices: depth mode height, px, 0..kMaxDepthSide (0: current)
-  int fps = 0;                   ///< devices: depth mode rate, Hz, 0..1000 (0: current)
+  double playback_speed = 1.0;                            ///< real_time recordings: (0, 16], 1 = as recorded
+  int width = 0;   ///< devices: depth mode width, px, 0..kMaxDepthSide (0: current)
+  int height = 0;  ///< devices: depth mode height, px, 0..kMaxDepthSide (0: current)
+  int fps = 0;     ///< devices: depth mode rate, Hz, 0..1000 (0: current)
   /// Used when the stream reports no valid field of view (NaN fields: none).
   DepthIntrinsics fallback_intrinsics;
-  double step_timeout_s = 5.0;     ///< stepped: longest wait of one read, (0, 60]
-  double stall_timeout_s = 3.0;    ///< real_time recordings: silence that ends the stream, (0, 600]
-  double teardown_grace_s = 0.1;   ///< wait between stopping and destroying the stream, [0, 5]
+  /// Stepped: wait for a frame that ends the stream, s on the injected Clock (also the most
+  /// real time one read blocks), (0, 60].
+  double step_timeout_s = 5.0;
+  double stall_timeout_s = 3.0;   ///< real_time recordings: silence that ends the stream, s (Clock), (0, 600]
+  double teardown_grace_s = 0.1;  ///< wait between stopping and destroying the stream, real s, [0, 5]
 };
 
 struct Openni2CameraStats {

@@ -1,5 +1,7 @@
 // pliant socketcan driver: the ATI F/T NETCANOEM CAN protocol, pure (no I/O).
-// Source: HARDWARE.md §1.2 (ATI manual 9610-05-1030 as used by three independent drivers).
+// Source: the ATI Net CAN OEM manual (ATI 9610-05-1030) as implemented by three independent
+// drivers (TRI, KIT, griloHBG); per-fact sources in docs/drivers/socketcan.md, "Device facts we
+// rely on".
 //
 // Addressing: a sensor has a 7-bit base ID (0..0x7F); every frame, request or response, has the
 // standard 11-bit ID (base_id << 4) | opcode, opcode 4 bits. All multi-byte fields are
@@ -77,18 +79,18 @@ const char* decode_error_name(DecodeError e) noexcept;
 /// One decoded response frame; only the fields of `opcode` are meaningful.
 struct Response {
   Opcode opcode = Opcode::read_gauges;
-  std::uint16_t status = 0;           ///< read_gauges
-  std::int16_t gauges[3] = {0, 0, 0};  ///< read_gauges: SG0 SG2 SG4; gauges_second: SG1 SG3 SG5
-  float matrix[2] = {0, 0};            ///< read_matrix / matrix_second / matrix_third: two columns
-  char serial[8] = {};                 ///< read_serial: 8 bytes as sent (not NUL-terminated)
-  std::uint8_t byte = 0;               ///< set_calibration echo, set_base_id / set_baud ack byte (0 if none)
+  std::uint16_t status = 0;             ///< read_gauges
+  std::int16_t gauges[3] = {0, 0, 0};   ///< read_gauges: SG0 SG2 SG4; gauges_second: SG1 SG3 SG5
+  float matrix[2] = {0, 0};             ///< read_matrix / matrix_second / matrix_third: two columns
+  char serial[8] = {};                  ///< read_serial: 8 bytes as sent (not NUL-terminated)
+  std::uint8_t byte = 0;                ///< set_calibration echo, set_base_id / set_baud ack byte (0 if none)
   std::uint32_t counts_per_force = 0;   ///< read_counts
   std::uint32_t counts_per_torque = 0;  ///< read_counts
   std::uint8_t force_unit = 0;          ///< read_units
   std::uint8_t torque_unit = 0;         ///< read_units
   std::uint16_t adc = 0;                ///< read_adc
   std::uint8_t firmware_major = 0, firmware_minor = 0;  ///< read_firmware
-  std::uint16_t firmware_build = 0;                      ///< read_firmware
+  std::uint16_t firmware_build = 0;                     ///< read_firmware
 };
 
 /// Payload lengths of the responses (0: none / not a response).
@@ -131,14 +133,20 @@ double torque_unit_to_newton_metre(std::uint8_t code) noexcept;
 
 /// A calibration as the sensor reports it (or as a user enters it from the calibration file).
 struct Calibration {
-  float matrix[36] = {};              ///< row-major, row r = axis r (Fx Fy Fz Tx Ty Tz), counts per gauge count
+  float matrix[36] = {};                ///< row-major, row r = axis r (Fx Fy Fz Tx Ty Tz), counts per gauge count
   std::uint32_t counts_per_force = 0;   ///< > 0
   std::uint32_t counts_per_torque = 0;  ///< > 0
   std::uint8_t force_unit = 2;          ///< unit code (2: N)
   std::uint8_t torque_unit = 3;         ///< unit code (3: N m)
 };
 
-enum class CalibrationError : std::uint8_t { none = 0, non_finite_matrix, zero_counts, unknown_force_unit, unknown_torque_unit };
+enum class CalibrationError : std::uint8_t {
+  none = 0,
+  non_finite_matrix,
+  zero_counts,
+  unknown_force_unit,
+  unknown_torque_unit
+};
 const char* calibration_error_name(CalibrationError e) noexcept;
 CalibrationError check(const Calibration& c) noexcept;
 
@@ -150,7 +158,8 @@ struct Scaling {
 CalibrationError make_scaling(const Calibration& c, Scaling& out) noexcept;
 
 /// wrench[6] (N, N m) = scaling.matrix * (gauges - bias). bias in counts (may be fractional).
-void gauges_to_wrench(const Scaling& scaling, const std::int16_t gauges[6], const double bias[6], double wrench[6]) noexcept;
+void gauges_to_wrench(const Scaling& scaling, const std::int16_t gauges[6], const double bias[6],
+                      double wrench[6]) noexcept;
 
 /// Status word bits: 1-7, 11, 12 mean the reading must not be trusted (the hal's kFtFaultMask).
 inline constexpr std::uint16_t kCriticalStatusMask = 0x18fe;

@@ -2,7 +2,7 @@
 // hal::ForceTorqueSensor.
 //
 // Lifecycle
-//   configure  checks the config, sets the receive filter (the 14 response opcodes of the base
+//   configure  checks the config, sets the receive filter (the 13 response opcodes of the base
 //              ID) and opens the transport; fails with the transport's status (unsupported,
 //              disconnected, io_error) when it cannot. Sends nothing.
 //   start      discards frames queued while inactive and starts the setup sequence; all I/O
@@ -21,8 +21,8 @@
 //                             the matrix); setup is retried every link.reconnect_interval_s
 //   stop       forgets the outstanding poll.
 //   cleanup    closes the transport.
-// Setup sequence (HARDWARE.md §1.2): SET_ACTIVE_CALIBRATION (the echo must match), then, when
-//   calibration_from_device, READ_MATRIX for the 6 axes, READ_COUNTS_PER_UNIT and
+// Setup sequence (docs/drivers/socketcan.md): SET_ACTIVE_CALIBRATION (the echo must match),
+//   then, when calibration_from_device, READ_MATRIX for the 6 axes, READ_COUNTS_PER_UNIT and
 //   READ_UNIT_CODES; then READ_SERIAL_NUMBER and READ_FIRMWARE_VERSION (info()). A step not
 //   answered within response_timeout_s is sent again. After a reconnect the sequence runs again
 //   (the sensor may have been power-cycled and lost its active calibration).
@@ -59,15 +59,15 @@ namespace pliant::drivers::socketcan {
 inline constexpr int kMaxTareSamples = 100000;
 
 struct AtiNetCanConfig {
-  std::uint8_t base_id = 0x20;           ///< 0..0x7F (the board's switch/EEPROM setting)
-  std::uint8_t calibration_index = 0;    ///< 0..15
-  double poll_period_s = 0.0;            ///< >= 0: minimum time between READ_SG polls (0: every read)
-  double response_timeout_s = 0.02;      ///< > 0: a request without its full answer is sent again
-  double timeout_s = 0.1;                ///< > 0: no complete sample for this long -> timeout
-  bool calibration_from_device = true;   ///< read matrix, counts and units from the sensor
-  ati::Calibration calibration;          ///< used when !calibration_from_device (from the calibration file)
+  std::uint8_t base_id = 0x20;                ///< 0..0x7F (the board's switch/EEPROM setting)
+  std::uint8_t calibration_index = 0;         ///< 0..15
+  double poll_period_s = 0.0;                 ///< >= 0: minimum time between READ_SG polls (0: every read)
+  double response_timeout_s = 0.02;           ///< > 0: a request without its full answer is sent again
+  double timeout_s = 0.1;                     ///< > 0: no complete sample for this long -> timeout
+  bool calibration_from_device = true;        ///< read matrix, counts and units from the sensor
+  ati::Calibration calibration;               ///< used when !calibration_from_device (from the calibration file)
   double gauge_bias[6] = {0, 0, 0, 0, 0, 0};  ///< initial tare, gauge counts (finite)
-  int tare_samples_on_start = 0;         ///< 0..kMaxTareSamples: tare after start's setup (not after a reconnect's)
+  int tare_samples_on_start = 0;  ///< 0..kMaxTareSamples: tare after start's setup (not after a reconnect's)
   CanLinkConfig link;
 };
 
@@ -98,11 +98,13 @@ struct AtiCounters {
   std::uint64_t setup_requests = 0;      ///< setup requests sent (including repeats)
   std::uint64_t setup_retries = 0;       ///< setup requests repeated after response_timeout_s
   std::uint64_t setups_completed = 0;
-  std::uint64_t setup_failures = 0;      ///< setups ended by a setup_error
+  std::uint64_t setup_failures = 0;  ///< setups ended by a setup_error
   std::uint64_t tares_completed = 0;
-  std::uint64_t send_failures = 0;       ///< requests the link could not send
+  std::uint64_t send_failures = 0;  ///< requests the link could not send
   /// Every frame this device dropped as malformed or unexpected.
-  std::uint64_t dropped_frames() const noexcept { return foreign_frames + unknown_opcodes + wrong_dlc + unexpected_frames; }
+  std::uint64_t dropped_frames() const noexcept {
+    return foreign_frames + unknown_opcodes + wrong_dlc + unexpected_frames;
+  }
 };
 
 class AtiNetCanForceTorque final : public hal::ForceTorqueSensor {
@@ -141,7 +143,15 @@ class AtiNetCanForceTorque final : public hal::ForceTorqueSensor {
 
  private:
   enum class Phase : std::uint8_t { setup, polling, failed };
-  enum class Step : std::uint8_t { set_calibration, read_matrix, read_counts, read_units, read_serial, read_firmware, done };
+  enum class Step : std::uint8_t {
+    set_calibration,
+    read_matrix,
+    read_counts,
+    read_units,
+    read_serial,
+    read_firmware,
+    done
+  };
 
   void restart_setup(double now) noexcept;
   void handle_frame(const CanFrame& frame, double stamp_s, double now, hal::WrenchReading& sample, bool& have) noexcept;
@@ -181,7 +191,7 @@ class AtiNetCanForceTorque final : public hal::ForceTorqueSensor {
   int tare_target_ = 0;
   int tare_count_ = 0;
   double tare_sum_[6] = {0, 0, 0, 0, 0, 0};
-  bool tare_blocks_ = false;  ///< withhold samples until the running tare completes
+  bool tare_blocks_ = false;       ///< withhold samples until the running tare completes
   bool tare_after_setup_ = false;  ///< the setup in progress follows start() (tare_samples_on_start applies)
 };
 

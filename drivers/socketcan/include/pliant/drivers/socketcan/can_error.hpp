@@ -1,4 +1,5 @@
-// pliant socketcan driver: what a SocketCAN error frame says (Linux can/error.h, HARDWARE.md §6).
+// pliant socketcan driver: what a SocketCAN error frame says (Linux can/error.h; see
+// docs/drivers/socketcan.md, "Device facts we rely on").
 //
 // The kernel sends error frames to sockets that asked for them (CAN_RAW_ERR_FILTER). One frame
 // has kCanErrFlag in its id, class bits in id bits 0-9, and details in data (DLC 8):
@@ -56,10 +57,13 @@ struct CanErrorReport {
   bool bus_off() const noexcept { return (classes & kCanErrBusOff) != 0; }
   /// The controller is usable again: it restarted after bus-off, or reports error-active.
   bool recovered() const noexcept {
-    return (classes & kCanErrRestarted) != 0 || ((classes & kCanErrController) != 0 && (controller & kCanCtrlActive) != 0);
+    return (classes & kCanErrRestarted) != 0 ||
+           ((classes & kCanErrController) != 0 && (controller & kCanCtrlActive) != 0);
   }
   /// Received frames were lost in the controller or the socket's queue.
-  bool rx_overflow() const noexcept { return (classes & kCanErrController) != 0 && (controller & kCanCtrlRxOverflow) != 0; }
+  bool rx_overflow() const noexcept {
+    return (classes & kCanErrController) != 0 && (controller & kCanCtrlRxOverflow) != 0;
+  }
 };
 
 /// Decodes an error frame. False (report untouched) when `frame` is not an error frame.

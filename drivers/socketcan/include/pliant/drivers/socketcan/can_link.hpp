@@ -30,7 +30,7 @@
 namespace pliant::drivers::socketcan {
 
 struct CanLinkConfig {
-  double reconnect_interval_s = 0.5;  ///< > 0: time between reopen attempts while disconnected
+  double reconnect_interval_s = 0.5;   ///< > 0: time between reopen attempts while disconnected
   int max_frames_per_read = 64;        ///< 1..4096: frames (of any kind) consumed per read
   bool use_receive_timestamps = true;  ///< stamp samples with the kernel receive time
   double max_receive_age_s = 1.0;      ///< > 0: older receive stamps are not trusted (clock steps)

@@ -35,13 +35,13 @@
 
 namespace pliant::drivers::socketcan {
 
-enum class [[nodiscard]] CanIo : std::uint8_t {
-  ok = 0,        ///< one frame sent or received
-  empty,         ///< receive: nothing queued (not an error)
-  busy,          ///< send: the transmit queue is full (ENOBUFS/EAGAIN); the frame was not sent
-  malformed,     ///< receive: a record that is not a CAN frame was consumed and discarded
-  disconnected,  ///< the link is gone; the transport closed itself
-  io_error,      ///< any other system error (see last_errno())
+enum class [[nodiscard]] CanIo : std::uint8_t{
+    ok = 0,        ///< one frame sent or received
+    empty,         ///< receive: nothing queued (not an error)
+    busy,          ///< send: the transmit queue is full (ENOBUFS/EAGAIN); the frame was not sent
+    malformed,     ///< receive: a record that is not a CAN frame was consumed and discarded
+    disconnected,  ///< the link is gone; the transport closed itself
+    io_error,      ///< any other system error (see last_errno())
 };
 
 const char* can_io_name(CanIo io) noexcept;

@@ -27,9 +27,9 @@
 namespace pliant::drivers::socketcan {
 
 struct RawCanConfig {
-  char interface_name[16] = "can0";               ///< NUL-terminated, at most 15 characters
+  char interface_name[16] = "can0";                 ///< NUL-terminated, at most 15 characters
   std::uint32_t error_mask = kDefaultCanErrorMask;  ///< error classes to receive (0: none)
-  bool receive_timestamps = true;                 ///< SO_TIMESTAMP on received frames
+  bool receive_timestamps = true;                   ///< SO_TIMESTAMP on received frames
 };
 
 class RawCanTransport final : public CanTransport {

@@ -1,5 +1,6 @@
 // pliant socketcan driver: the Robotous RFT (RFT40/60/80) CAN protocol, pure (no I/O).
-// Source: HARDWARE.md §1.3 (Robotous packet header and CAN sample, CORC RobotousRFT).
+// Sources: Robotous's packet header RFT_IF_PACKET Rev1.0 and CAN sample, CORC RobotousRFT;
+// per fact in docs/drivers/socketcan.md, "Device facts we rely on".
 //
 // IDs: one command ID (host -> sensor; sample default 0x64) and two response IDs (sensor ->
 // host; defaults 0x01 and 0x02), all standard 11-bit, 1 Mbit/s.
@@ -81,11 +82,11 @@ void raw_to_wrench(const std::int16_t raw[6], double force_divider, double torqu
 class PacketAssembler {
  public:
   enum class Result : std::uint8_t {
-    partial,          ///< a first half is held
-    complete,         ///< packet() holds 16 bytes; the assembler is empty again
-    replaced_first,   ///< a first half arrived while one was held: the older one was discarded
-    orphan_second,    ///< a second half with no first: discarded
-    ignored,          ///< role foreign or wrong_dlc: not a half of any packet
+    partial,         ///< a first half is held
+    complete,        ///< packet() holds 16 bytes; the assembler is empty again
+    replaced_first,  ///< a first half arrived while one was held: the older one was discarded
+    orphan_second,   ///< a second half with no first: discarded
+    ignored,         ///< role foreign or wrong_dlc: not a half of any packet
   };
   Result add(FrameRole role, const CanFrame& frame) noexcept;
   /// Forgets a held first half. True if one was held.

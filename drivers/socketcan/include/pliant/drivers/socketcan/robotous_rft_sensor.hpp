@@ -40,25 +40,25 @@
 namespace pliant::drivers::socketcan {
 
 struct RobotousRftConfig {
-  rft::Ids ids;                   ///< command and response IDs (standard, distinct)
-  double force_divider = 50.0;    ///< > 0: raw counts per N (model dependent)
-  double torque_divider = 2000.0; ///< > 0: raw counts per N m (model dependent)
-  int output_rate_code = -1;      ///< -1: leave the sensor's rate; 0..8: set it at start (see protocol)
-  bool bias_on_start = false;     ///< zero the sensor on its current load at start
-  double timeout_s = 0.1;         ///< > 0: no packet for this long -> timeout (and the stream is requested again)
+  rft::Ids ids;                    ///< command and response IDs (standard, distinct)
+  double force_divider = 50.0;     ///< > 0: raw counts per N (model dependent)
+  double torque_divider = 2000.0;  ///< > 0: raw counts per N m (model dependent)
+  int output_rate_code = -1;       ///< -1: leave the sensor's rate; 0..8: set it at start (see protocol)
+  bool bias_on_start = false;      ///< zero the sensor on its current load at start
+  double timeout_s = 0.1;          ///< > 0: no packet for this long -> timeout (and the stream is requested again)
   CanLinkConfig link;
 };
 
 struct RftCounters {
-  std::uint64_t stream_requests = 0;    ///< start-streaming commands sent (first and repeated)
-  std::uint64_t commands_sent = 0;      ///< every command frame sent
-  std::uint64_t send_failures = 0;      ///< commands the link could not send
-  std::uint64_t complete_packets = 0;   ///< F/T packets reassembled
-  std::uint64_t overload_packets = 0;   ///< ... with a non-zero overload byte
-  std::uint64_t incomplete_packets = 0; ///< first halves discarded (second lost) or seconds without first
-  std::uint64_t foreign_frames = 0;     ///< frames with another ID (dropped)
-  std::uint64_t wrong_dlc = 0;          ///< response IDs with DLC != 8 (dropped)
-  std::uint64_t other_responses = 0;    ///< complete packets that are not F/T data (consumed)
+  std::uint64_t stream_requests = 0;     ///< start-streaming commands sent (first and repeated)
+  std::uint64_t commands_sent = 0;       ///< every command frame sent
+  std::uint64_t send_failures = 0;       ///< commands the link could not send
+  std::uint64_t complete_packets = 0;    ///< F/T packets reassembled
+  std::uint64_t overload_packets = 0;    ///< ... with a non-zero overload byte
+  std::uint64_t incomplete_packets = 0;  ///< first halves discarded (second lost) or seconds without first
+  std::uint64_t foreign_frames = 0;      ///< frames with another ID (dropped)
+  std::uint64_t wrong_dlc = 0;           ///< response IDs with DLC != 8 (dropped)
+  std::uint64_t other_responses = 0;     ///< complete packets that are not F/T data (consumed)
   std::uint64_t dropped_frames() const noexcept { return foreign_frames + wrong_dlc + incomplete_packets; }
 };
 

@@ -27,7 +27,7 @@
 
 namespace pliant::drivers::socketcan {
 
-inline constexpr std::size_t kSeqpacketRecordSize = 16;  ///< sizeof(struct can_frame)
+inline constexpr std::size_t kSeqpacketRecordSize = 16;   ///< sizeof(struct can_frame)
 inline constexpr std::size_t kMaxSeqpacketAddress = 107;  ///< sun_path minus the terminator
 
 class SeqpacketCanTransport final : public CanTransport {

@@ -20,8 +20,8 @@
 namespace pliant::drivers::usb {
 
 struct UsbRowOptions {
-  bool include_unknown = false;      ///< also list devices the table does not know
-  std::string sysfs_root = "/sys";   ///< where to read strings and interface names ("" = skip)
+  bool include_unknown = false;     ///< also list devices the table does not know
+  std::string sysfs_root = "/sys";  ///< where to read strings and interface names ("" = skip)
 };
 
 struct UsbDeviceRow {

@@ -1,6 +1,6 @@
-// pliant drivers/usb: finding USB devices with libusb 1.0 (Debian 12: 1.0.26, HARDWARE.md
-// section 5): a one-shot enumeration, and a watch that reports arrivals and departures through
-// a non-blocking poll().
+// pliant drivers/usb: finding USB devices with libusb 1.0 (Debian 12: 1.0.26; facts in
+// docs/drivers/usb.md): a one-shot enumeration, and a watch that reports arrivals and
+// departures through a non-blocking poll().
 //
 // Watching: with hotplug support (libusb_has_capability(LIBUSB_CAP_HAS_HOTPLUG)), one callback
 // is registered for every device with LIBUSB_HOTPLUG_ENUMERATE, so the devices present at

@@ -1,5 +1,5 @@
 // pliant drivers/usb: the USB vendor and product ids of the devices pliant knows how to use (or
-// knows it cannot use), and which pliant driver handles each. HARDWARE.md section 5 lists the
+// knows it cannot use), and which pliant driver handles each. docs/drivers/usb.md lists the
 // sources (libfreenect, OpenNI2's PS1080/PSLink enumeration, Orbbec's udev rules, librealsense,
 // the Linux kernel's peak_usb, gs_usb and kvaser_usb drivers).
 //

@@ -5,7 +5,7 @@
 // the departure of a device whose arrival it never reported (libusb hotplug.c). UsbPresence
 // turns that stream into changes: an arrival of a device already present, or a departure of one
 // not present, produces no event (counted as a duplicate). A device is identified by its key:
-// bus, port path and address (HARDWARE.md section 5). A re-plugged device gets a new address and
+// bus, port path and address (docs/drivers/usb.md). A re-plugged device gets a new address and
 // so a new key; an arrival at a present key with other vendor:product ids replaces the old
 // device (a departure, then an arrival).
 // Without hotplug, reconcile() compares a fresh enumeration with the set and reports the
@@ -26,7 +26,7 @@ namespace pliant::drivers::usb {
 struct UsbDeviceKey {
   std::uint8_t bus = 0;
   std::uint8_t address = 0;
-  std::uint8_t port_count = 0;         ///< 0..7 (USB 3 allows 7 tiers below the root)
+  std::uint8_t port_count = 0;          ///< 0..7 (USB 3 allows 7 tiers below the root)
   std::array<std::uint8_t, 7> ports{};  ///< ports[0 .. port_count - 1]
   bool operator==(const UsbDeviceKey& other) const noexcept;
   bool operator!=(const UsbDeviceKey& other) const noexcept { return !(*this == other); }

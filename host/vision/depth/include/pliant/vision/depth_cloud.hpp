@@ -31,8 +31,8 @@ struct DepthToCloudOptions {
   /// Metres per raw depth unit, finite > 0: 1e-3 for millimetres (OpenNI2, RealSense, Kinect),
   /// 2e-4 for the TUM RGB-D benchmark (5000 units per metre).
   double depth_scale_m = 1e-3;
-  int stride = 1;      ///< >= 1: every stride-th column and row, counted from the region's corner
-  PixelRect region;    ///< region of interest; empty = the whole image; must lie inside the image
+  int stride = 1;            ///< >= 1: every stride-th column and row, counted from the region's corner
+  PixelRect region;          ///< region of interest; empty = the whole image; must lie inside the image
   double min_depth_m = 0.0;  ///< >= 0: nearer points are dropped (sensor blind zone)
   double max_depth_m = std::numeric_limits<double>::infinity();  ///< > min_depth_m: farther dropped
 };
@@ -42,7 +42,7 @@ struct DepthToCloudOptions {
 struct DepthCloud {
   std::vector<Eigen::Vector3f> points;
   std::vector<std::int32_t> pixel;
-  int image_width = 0;   ///< of the image the cloud came from
+  int image_width = 0;  ///< of the image the cloud came from
   int image_height = 0;
   std::size_t size() const noexcept { return points.size(); }
   /// Reserves room for `count` points so later conversions do not allocate.

@@ -36,12 +36,12 @@ class DepthError : public std::runtime_error {
 /// width and height are the image size the calibration is for; images of another size are
 /// refused. A default-constructed value is "missing" and refused by check_intrinsics.
 struct PinholeIntrinsics {
-  double fx = 0;  ///< focal length along u, px, finite > 0
-  double fy = 0;  ///< focal length along v, px, finite > 0
-  double cx = 0;  ///< principal point column, px, finite
-  double cy = 0;  ///< principal point row, px, finite
-  int width = 0;  ///< image columns, >= 1
-  int height = 0; ///< image rows, >= 1
+  double fx = 0;   ///< focal length along u, px, finite > 0
+  double fy = 0;   ///< focal length along v, px, finite > 0
+  double cx = 0;   ///< principal point column, px, finite
+  double cy = 0;   ///< principal point row, px, finite
+  int width = 0;   ///< image columns, >= 1
+  int height = 0;  ///< image rows, >= 1
 };
 
 /// Throws DepthError naming the first bad field ("intrinsics: fx must be finite and > 0 (missing

@@ -47,12 +47,12 @@ struct DepthSequenceOptions {
 using DepthFrameSource = std::function<DepthImageView(int index)>;
 
 struct DepthSequenceResult {
-  host::Recording recording;              ///< ready for host::write_recording
-  DepthFrameReport alignment;             ///< frame 0 looked at from the rest shape
-  std::vector<DepthFrameReport> frames;   ///< one per update (frames 1 ..)
+  host::Recording recording;             ///< ready for host::write_recording
+  DepthFrameReport alignment;            ///< frame 0 looked at from the rest shape
+  std::vector<DepthFrameReport> frames;  ///< one per update (frames 1 ..)
   DepthTrackerCounters counters;
-  TrackerCounters core;                   ///< the core tracker's counters (lost_events, outliers, ...)
-  int calibration_frames = 0;             ///< frames that calibrated the reference offsets
+  TrackerCounters core;        ///< the core tracker's counters (lost_events, outliers, ...)
+  int calibration_frames = 0;  ///< frames that calibrated the reference offsets
   /// Per frame and particle, frame-major [frame * particle_count + id]: why it was or was not
   /// observed (frame 0: the alignment look at the rest shape).
   std::vector<ParticleView> views;

@@ -88,26 +88,26 @@ struct DepthTrackerConfig {
   /// a rigid transform (rotation part orthonormal).
   Eigen::Isometry3d camera_to_world = Eigen::Isometry3d::Identity();
   Correspondence correspondence = Correspondence::point_to_plane;
-  int plane_neighbours = 12;          ///< k nearest points for the local plane and normal, 3..64
-  double gate_m = 0;                  ///< >= 0; 0: 0.5 x the model's spacing
-  double visibility_margin_m = 0;     ///< >= 0; 0: 0.5 x the model's spacing
-  int depth_window = 2;               ///< 0..16 px: half-width of the window searched for a valid depth
-  double max_view_angle_deg = 80.0;   ///< (0, 90]
-  double max_normal_angle_deg = 60.0; ///< (0, 180]
-  double depth_noise_m = 1e-3;        ///< > 0: floor of the correspondence scale (the sensor's depth sd)
-  double tukey_c = 4.685;             ///< > 0, in robust-scale units
-  int leaf_max_size = 16;             ///< 1..256, kd-tree leaf size
-  TrackerConfig tracker;              ///< the core tracker's settings (validated by tracker_init)
+  int plane_neighbours = 12;           ///< k nearest points for the local plane and normal, 3..64
+  double gate_m = 0;                   ///< >= 0; 0: 0.5 x the model's spacing
+  double visibility_margin_m = 0;      ///< >= 0; 0: 0.5 x the model's spacing
+  int depth_window = 2;                ///< 0..16 px: half-width of the window searched for a valid depth
+  double max_view_angle_deg = 80.0;    ///< (0, 90]
+  double max_normal_angle_deg = 60.0;  ///< (0, 180]
+  double depth_noise_m = 1e-3;         ///< > 0: floor of the correspondence scale (the sensor's depth sd)
+  double tukey_c = 4.685;              ///< > 0, in robust-scale units
+  int leaf_max_size = 16;              ///< 1..256, kd-tree leaf size
+  TrackerConfig tracker;               ///< the core tracker's settings (validated by tracker_init)
 };
 
 /// Counts of one frame.
 struct DepthFrameReport {
-  Status status = Status::ok;  ///< the core tracker's (no_observations: nothing usable; counted)
-  std::size_t points = 0;      ///< cloud points
-  int observed = 0;            ///< particles given an observation (== by_view[observed])
+  Status status = Status::ok;                     ///< the core tracker's (no_observations: nothing usable; counted)
+  std::size_t points = 0;                         ///< cloud points
+  int observed = 0;                               ///< particles given an observation (== by_view[observed])
   std::array<int, kParticleViewCount> by_view{};  ///< particles per ParticleView
-  double median_distance_m = 0;       ///< median correspondence distance of the candidates (0: none)
-  double correspondence_scale_m = 0;  ///< robust scale behind the Tukey weights
+  double median_distance_m = 0;                   ///< median correspondence distance of the candidates (0: none)
+  double correspondence_scale_m = 0;              ///< robust scale behind the Tukey weights
 };
 
 /// Monotonic totals since construction (reset() keeps them).

@@ -48,8 +48,8 @@ struct AdvectionConfig {
   /// [min_similarity, 1]: a template is retaken (commit) only from a patch at least this
   /// similar to it: it follows deformation, not an occluder sliding over the patch.
   double refresh_similarity = 0.9;
-  int patch_px = 11;             ///< odd, [5, 101]: side of the appearance patch
-  int search_radius_px = 4;      ///< [0, 50]: reach of the template search (step 4)
+  int patch_px = 11;         ///< odd, [5, 101]: side of the appearance patch
+  int search_radius_px = 4;  ///< [0, 50]: reach of the template search (step 4)
   /// DIS pyramid level the flow is resolved at (0..4); -1: dis_finest_scale_for_spacing of the
   /// particle spacing (the tracking pipeline resolves it before constructing the advector).
   int dis_finest_scale = -1;
@@ -114,9 +114,9 @@ class FlowAdvector {
   cv::Mat previous_, next_, forward_, backward_, patch_;
   std::vector<cv::Mat> templates_;
   std::vector<double> last_similarity_;
-  std::vector<cv::Point2d> advected_;          // eq. 14 positions, then refined
-  std::vector<cv::Point2f> from_, to_;         // calcOpticalFlowPyrLK's points
-  std::vector<std::size_t> index_;             // particle of each LK point
+  std::vector<cv::Point2d> advected_;   // eq. 14 positions, then refined
+  std::vector<cv::Point2f> from_, to_;  // calcOpticalFlowPyrLK's points
+  std::vector<std::size_t> index_;      // particle of each LK point
   std::vector<unsigned char> lk_status_;
   std::vector<float> lk_error_;
 };

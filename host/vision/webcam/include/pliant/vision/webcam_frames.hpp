@@ -68,10 +68,10 @@ std::vector<std::string> expand_image_pattern(const std::string& input);
 
 /// One frame as the tracker uses it.
 struct GreyFrame {
-  cv::Mat grey;         ///< CV_8UC1, the first frame's size
-  double t_s = 0;       ///< seconds since the source's first frame
-  int source_index = 0; ///< index in the source (before resampling)
-  std::string label;    ///< names the frame in messages
+  cv::Mat grey;          ///< CV_8UC1, the first frame's size
+  double t_s = 0;        ///< seconds since the source's first frame
+  int source_index = 0;  ///< index in the source (before resampling)
+  std::string label;     ///< names the frame in messages
 };
 
 /// Picks frames of a source at a lower rate: with source rate f and target r <= f, source

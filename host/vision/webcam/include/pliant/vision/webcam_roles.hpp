@@ -37,8 +37,8 @@ SupportSpec parse_support(const std::string& text);
 struct DrivenSpec {
   enum class Kind { detect, id, point };
   Kind kind = Kind::detect;
-  int id = 0;          ///< Kind::id
-  cv::Point2d point;   ///< Kind::point: the particle nearest to this first-frame pixel position
+  int id = 0;         ///< Kind::id
+  cv::Point2d point;  ///< Kind::point: the particle nearest to this first-frame pixel position
 };
 
 /// "auto" | "ID" | "X,Y" (pixels in the first frame).

@@ -42,24 +42,24 @@ namespace pliant::vision::webcam {
 struct TrackOptions {
   FlowMethod flow = FlowMethod::dis;
   AdvectionConfig advection;
-  double tracker_msm_beta = 0.5;  ///< [0, 1]: the tracker's prior (see the top of this file)
-  TrackerConfig tracker;          ///< core defaults; observation_gain 1 keeps observations exact
-  SupportSpec support;            ///< detected by default
-  DrivenSpec driven;              ///< detected by default
+  double tracker_msm_beta = 0.5;        ///< [0, 1]: the tracker's prior (see the top of this file)
+  TrackerConfig tracker;                ///< core defaults; observation_gain 1 keeps observations exact
+  SupportSpec support;                  ///< detected by default
+  DrivenSpec driven;                    ///< detected by default
   ProgressCallback progress = nullptr;  ///< (context, frames done, frames expected or -1)
   void* progress_context = nullptr;
 };
 
 /// Trajectories of a tracked video. Per-frame arrays are frame-major: [frame * particles + id].
 struct TrackResult {
-  std::string source;            ///< the input as named
+  std::string source;  ///< the input as named
   cv::Size frame_size;
   double source_fps_hz = 0;
-  double rate_hz = 0;            ///< frames per second kept (the source's when not resampled)
-  ParticleGrid grid;             ///< the seeds (first frame)
-  std::vector<double> times_s;   ///< frame times, s, from 0, strictly increasing
-  std::vector<int> source_index; ///< frame index in the source
-  std::vector<cv::Point2d> tracked;  ///< tracker positions, px (every frame, every particle)
+  double rate_hz = 0;                  ///< frames per second kept (the source's when not resampled)
+  ParticleGrid grid;                   ///< the seeds (first frame)
+  std::vector<double> times_s;         ///< frame times, s, from 0, strictly increasing
+  std::vector<int> source_index;       ///< frame index in the source
+  std::vector<cv::Point2d> tracked;    ///< tracker positions, px (every frame, every particle)
   std::vector<std::uint8_t> observed;  ///< 1: the tracker used an observation of it this frame
   std::vector<std::uint8_t> check;     ///< ObservationKind of the frame's candidate
   std::vector<std::uint8_t> status;    ///< TrackStatus after the frame
@@ -68,7 +68,7 @@ struct TrackResult {
   std::vector<double> motion_px;       ///< per particle: largest distance from its seed
   ParticleRoles roles;
   TrackerCounters counters;
-  TrackOptions options;          ///< as used (progress callback cleared)
+  TrackOptions options;  ///< as used (progress callback cleared)
 
   int frame_count() const { return static_cast<int>(times_s.size()); }
   int particle_count() const { return grid.size(); }

@@ -1,8 +1,8 @@
 // pliant socketcan driver, emulator: an ATI F/T sensor with a NETCANOEM board on the far end
-// of a CanTransport (HARDWARE.md §1.2). For tests, and for HIL rigs that run the real driver
-// against a sensor that is not there: put the emulator on one end of a SeqpacketCanTransport
-// pair (or on a second RawCanTransport on the same vcan/can bus) and step it from the rig's
-// loop.
+// of a CanTransport (protocol: docs/drivers/socketcan.md). For tests, and for HIL rigs that
+// run the real driver against a sensor that is not there: put the emulator on one end of a
+// SeqpacketCanTransport pair (or on a second RawCanTransport on the same vcan/can bus) and
+// step it from the rig's loop.
 //
 // service() answers every queued request the way the board does: READ_SG with its two frames
 // (status, SG0, SG2, SG4 / SG1, SG3, SG5), READ_MATRIX with three frames, SET_ACTIVE_CALIBRATION
@@ -33,12 +33,12 @@ struct AtiEmulatorConfig {
 };
 
 struct AtiEmulatorFaults {
-  bool mute = false;          ///< consume requests, answer nothing
-  bool swap_halves = false;   ///< send the second gauge frame before the first
-  int drop_first_halves = 0;  ///< omit the first gauge frame of the next N READ_SG answers
-  int drop_second_halves = 0; ///< omit the second gauge frame of the next N READ_SG answers
+  bool mute = false;               ///< consume requests, answer nothing
+  bool swap_halves = false;        ///< send the second gauge frame before the first
+  int drop_first_halves = 0;       ///< omit the first gauge frame of the next N READ_SG answers
+  int drop_second_halves = 0;      ///< omit the second gauge frame of the next N READ_SG answers
   int duplicate_first_halves = 0;  ///< send the first gauge frame twice in the next N answers
-  int wrong_dlc_answers = 0;  ///< next N READ_SG answers: the second frame with DLC 5 instead of 6
+  int wrong_dlc_answers = 0;       ///< next N READ_SG answers: the second frame with DLC 5 instead of 6
 };
 
 struct AtiEmulatorCounters {

@@ -1,5 +1,5 @@
 // pliant socketcan driver, emulator: a Robotous RFT sensor on the far end of a CanTransport
-// (HARDWARE.md §1.3). For tests and HIL rigs, like AtiNetCanEmulator.
+// (protocol: docs/drivers/socketcan.md). For tests and HIL rigs, like AtiNetCanEmulator.
 //
 // service() handles queued commands: 10 (one F/T packet), 11 (start streaming), 12 (stop),
 // 17 (bias on: zero on the current load; off: absolute), 15 (set output rate; answered with
@@ -25,21 +25,21 @@ struct RftEmulatorConfig {
 };
 
 struct RftEmulatorFaults {
-  bool mute = false;             ///< consume commands, answer and stream nothing
-  int drop_first_halves = 0;     ///< next N packets without their first frame
-  int drop_second_halves = 0;    ///< next N packets without their second frame
-  int swap_halves = 0;           ///< next N packets with the second frame first
-  int wrong_dlc = 0;             ///< next N packets with a 7-byte second frame
+  bool mute = false;           ///< consume commands, answer and stream nothing
+  int drop_first_halves = 0;   ///< next N packets without their first frame
+  int drop_second_halves = 0;  ///< next N packets without their second frame
+  int swap_halves = 0;         ///< next N packets with the second frame first
+  int wrong_dlc = 0;           ///< next N packets with a 7-byte second frame
 };
 
 struct RftEmulatorCounters {
-  std::uint64_t commands = 0;          ///< frames on the command ID
-  std::uint64_t stream_starts = 0;     ///< command 11
-  std::uint64_t stream_stops = 0;      ///< command 12
-  std::uint64_t bias_commands = 0;     ///< command 17
-  std::uint64_t rate_commands = 0;     ///< command 15
-  std::uint64_t packets_sent = 0;      ///< F/T packets (one or both halves sent)
-  std::uint64_t ignored_frames = 0;    ///< other IDs, unknown codes, error frames, DLC != 8
+  std::uint64_t commands = 0;        ///< frames on the command ID
+  std::uint64_t stream_starts = 0;   ///< command 11
+  std::uint64_t stream_stops = 0;    ///< command 12
+  std::uint64_t bias_commands = 0;   ///< command 17
+  std::uint64_t rate_commands = 0;   ///< command 15
+  std::uint64_t packets_sent = 0;    ///< F/T packets (one or both halves sent)
+  std::uint64_t ignored_frames = 0;  ///< other IDs, unknown codes, error frames, DLC != 8
   std::uint64_t send_failures = 0;
 };
 

@@ -52,26 +52,26 @@ enum class EmulatorTransport : std::uint8_t { tcp, rtu_pty };
 
 struct ModbusEmulatorConfig {
   EmulatorTransport transport = EmulatorTransport::tcp;
-  std::uint16_t port = 0;         ///< tcp; 0 = any free port
-  int slave_id = 9;               ///< 1..247
-  Robotiq2fModelConfig gripper;   ///< model, object and scaling
-  bool real_time = false;         ///< see "Time" above
-  int ft_grip_force_axis = -1;    ///< -1: none; 0..5: add the grip force (N) to this wrench axis
+  std::uint16_t port = 0;        ///< tcp; 0 = any free port
+  int slave_id = 9;              ///< 1..247
+  Robotiq2fModelConfig gripper;  ///< model, object and scaling
+  bool real_time = false;        ///< see "Time" above
+  int ft_grip_force_axis = -1;   ///< -1: none; 0..5: add the grip force (N) to this wrench axis
 };
 
 struct ModbusEmulatorCounters {
-  std::uint64_t requests = 0;        ///< requests received for our slave ID
-  std::uint64_t replies = 0;         ///< normal answers sent (exceptions included)
-  std::uint64_t exceptions = 0;      ///< exception answers (illegal function injected or address)
-  std::uint64_t dropped = 0;         ///< requests left unanswered by drop_replies
-  std::uint64_t corrupted = 0;       ///< answers damaged by corrupt_replies
-  std::uint64_t other_slave = 0;     ///< requests for another slave ID (no answer)
-  std::uint64_t bad_requests = 0;    ///< receive errors (malformed request, CRC)
-  std::uint64_t connections = 0;     ///< TCP connections accepted and served
-  std::uint64_t refused = 0;         ///< TCP connections closed at once (refusing, or 8 already)
-  std::uint64_t disconnects = 0;     ///< TCP connections that ended (either side)
-  std::uint64_t command_writes = 0;  ///< writes that reached the gripper command block
-  std::uint64_t stream_requests = 0; ///< writes of 0x0200 to register 410
+  std::uint64_t requests = 0;         ///< requests received for our slave ID
+  std::uint64_t replies = 0;          ///< normal answers sent (exceptions included)
+  std::uint64_t exceptions = 0;       ///< exception answers (illegal function injected or address)
+  std::uint64_t dropped = 0;          ///< requests left unanswered by drop_replies
+  std::uint64_t corrupted = 0;        ///< answers damaged by corrupt_replies
+  std::uint64_t other_slave = 0;      ///< requests for another slave ID (no answer)
+  std::uint64_t bad_requests = 0;     ///< receive errors (malformed request, CRC)
+  std::uint64_t connections = 0;      ///< TCP connections accepted and served
+  std::uint64_t refused = 0;          ///< TCP connections closed at once (refusing, or 8 already)
+  std::uint64_t disconnects = 0;      ///< TCP connections that ended (either side)
+  std::uint64_t command_writes = 0;   ///< writes that reached the gripper command block
+  std::uint64_t stream_requests = 0;  ///< writes of 0x0200 to register 410
 };
 
 /// A snapshot of the simulated gripper.
@@ -96,8 +96,8 @@ class ModbusEmulator {
   /// Stops the thread and closes everything. Idempotent.
   void stop();
 
-  std::uint16_t port() const;        ///< tcp: the bound port (after start)
-  std::string device_path() const;   ///< rtu_pty: the slave side of the pseudo-terminal
+  std::uint16_t port() const;       ///< tcp: the bound port (after start)
+  std::string device_path() const;  ///< rtu_pty: the slave side of the pseudo-terminal
 
   // Simulation.
   void advance(double dt_s);

@@ -34,12 +34,12 @@
 namespace pliant::drivers::modbus {
 
 struct Robotiq2fModelConfig {
-  robotiq2f::Scaling scaling;                  ///< 2F-85 by default
-  double activation_time_s = 0.5;              ///< >= 0
-  double object_width_m = std::numeric_limits<double>::quiet_NaN();  ///< NaN: nothing to grasp
+  robotiq2f::Scaling scaling;                                                 ///< 2F-85 by default
+  double activation_time_s = 0.5;                                             ///< >= 0
+  double object_width_m = std::numeric_limits<double>::quiet_NaN();           ///< NaN: nothing to grasp
   double object_stiffness_n_per_m = std::numeric_limits<double>::infinity();  ///< > 0, +inf rigid
-  double current_per_newton_a = 0.003;         ///< >= 0
-  double moving_current_a = 0.05;              ///< >= 0
+  double current_per_newton_a = 0.003;                                        ///< >= 0
+  double moving_current_a = 0.05;                                             ///< >= 0
 };
 
 class Robotiq2fModel {
