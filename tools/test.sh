@@ -31,6 +31,19 @@ use_ccache() {
 }
 use_ccache
 
+# A build folder configured earlier with another generator (make, before this script used Ninja)
+# cannot be reconfigured in place: start it afresh.
+forget_other_generator() {
+  local dir
+  for dir in build build-asan build-fuzz build-lint build-aarch64 build-cortex-m7; do
+    if [ -f "$dir/CMakeCache.txt" ] && ! grep -qx "CMAKE_GENERATOR:INTERNAL=$CMAKE_GENERATOR" "$dir/CMakeCache.txt"; then
+      echo "test.sh: $dir was configured with another generator; configuring it afresh"
+      rm -rf "$dir/CMakeCache.txt" "$dir/CMakeFiles"
+    fi
+  done
+}
+forget_other_generator
+
 setup() { bash tools/setup-debian.sh; }
 
 release() {

@@ -732,8 +732,8 @@ PLIANT_INLINE void integrate_particles(const MsmModel<Dim, Scalar>& model, const
     Vec next;
     if (fixed[i] != 0 && pinned) {
       next = rest[i];
-    } else if (driven_now[i] != 0) {
-      next = predicted[i];  // the goal of a driven particle is its target
+    } else if (driven_now[i] != 0) {  // NOLINT(bugprone-branch-clone): as the last branch, for another reason
+      next = predicted[i];            // the goal of a driven particle is its target
     } else if (inverse_cluster_count[i] > Scalar(0)) {
       Moment map_sum;
       gather_sum(goal_maps, particle_cluster_offset, particle_cluster_begin[i], particle_cluster_begin[i + 1], map_sum);

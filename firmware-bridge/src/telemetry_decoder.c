@@ -15,12 +15,11 @@ static void track_sequence(pliant_tm_decoder_t* d, uint16_t seq, uint64_t stamp_
     /* An earlier stamp means the emitter restarted (or packets were reordered): its sequence
      * number says nothing about loss. Otherwise half the sequence space ahead counts as missed
      * packets, and anything else went back. */
-    if (stamp_us < d->last_stamp_us) {
+    const int went_back = stamp_us < d->last_stamp_us || jump >= 0x8000u;
+    if (went_back) {
       ++d->counters.seq_backward;
-    } else if (jump != 0u && jump < 0x8000u) {
-      d->counters.seq_missed += jump;
     } else if (jump != 0u) {
-      ++d->counters.seq_backward;
+      d->counters.seq_missed += jump;
     }
   }
   d->next_seq = (uint16_t)(seq + 1u);

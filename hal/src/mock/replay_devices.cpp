@@ -132,8 +132,8 @@ HalStatus ReplayParticleObserver::on_read(ParticleFrame& out) noexcept {
   int observed = 0;
   for (int i = 0; i < n; ++i) {
     bool finite = true;
-    for (int d = 0; d < dimension_; ++d)
-      finite = finite && std::isfinite(frame_[static_cast<std::size_t>(i * dimension_ + d)]);
+    const std::size_t first = static_cast<std::size_t>(i) * static_cast<std::size_t>(dimension_);
+    for (int d = 0; d < dimension_; ++d) finite = finite && std::isfinite(frame_[first + static_cast<std::size_t>(d)]);
     observed += finite ? 1 : 0;
   }
   set_header(out.header, s, bits);

@@ -77,8 +77,8 @@ HalStatus SimulatedGrasp::configure(const SimulatedGraspConfig& config) {
   if (n < 8) return HalStatus::invalid_argument;
   double low = rest_[0], high = rest_[0];
   for (int i = 0; i < n; ++i) {
-    low = std::min(low, rest_[static_cast<std::size_t>(3 * i)]);
-    high = std::max(high, rest_[static_cast<std::size_t>(3 * i)]);
+    low = std::min(low, rest_[3 * static_cast<std::size_t>(i)]);
+    high = std::max(high, rest_[3 * static_cast<std::size_t>(i)]);
   }
   if (!(c.max_width_m > high - low)) return HalStatus::invalid_argument;
   if (std::isfinite(c.initial_width_m) && (c.initial_width_m > c.max_width_m || c.initial_width_m < 0)) {
