@@ -41,10 +41,13 @@ def preprocess_command(entry):
 
 
 def cache_key(entry, salt):
+    """The key of a unit; the checkout's own path is taken out, so that clones elsewhere share it."""
+    root = os.getcwd()
     text = subprocess.run(preprocess_command(entry), cwd=entry["directory"], capture_output=True, check=False).stdout
     digest = hashlib.sha256(salt)
-    digest.update(entry.get("command", " ".join(entry.get("arguments", []))).encode())
-    digest.update(text)
+    command = entry.get("command", " ".join(entry.get("arguments", [])))
+    digest.update(command.replace(root, "<root>").encode())
+    digest.update(text.replace(root.encode(), b"<root>"))
     return digest.hexdigest()[:40]
 
 
