@@ -47,7 +47,8 @@ forget_other_generator
 setup() { bash tools/setup-debian.sh; }
 
 release() {
-  cmake -S . -B build -DCMAKE_BUILD_TYPE=Release > /dev/null
+  # Tests and benchmarks named: tools/demo.sh configures the same folder without them.
+  cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DPLIANT_BUILD_TESTS=ON -DPLIANT_BUILD_BENCHMARKS=ON > /dev/null
   cmake --build build -j"$jobs"
   ctest --test-dir build -j"$jobs" --output-on-failure
 }
