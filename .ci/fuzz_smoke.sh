@@ -23,8 +23,12 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${PLIANT_FUZZ_BUILD_DIR:-$root/build-fuzz}"
 seconds="${PLIANT_FUZZ_SECONDS:-60}"
 
+# -O1 with line tables: libFuzzer's recommended optimisation, file and line in every report, and
+# less compile time than -O2 -g.
 cmake -S "$root" -B "$build" \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only -DNDEBUG" \
+  -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only -DNDEBUG" \
   -DCMAKE_CXX_COMPILER="${CXX_FUZZ:-clang++}" \
   -DCMAKE_C_COMPILER="${CC_FUZZ:-clang}" \
   -DPLIANT_BUILD_FUZZERS=ON \

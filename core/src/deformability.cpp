@@ -14,7 +14,8 @@ Status check_inputs(const MsmModel<Dim, Scalar>& model, const ObservationSequenc
                     const DeformabilityConfig& config, const DeformabilityWorkspace<Dim, Scalar>& ws) noexcept {
   if (!model.initialized() || !ws.state.initialized()) return Status::not_initialized;
   if (config.grid_points < 3 || !(config.tolerance > 0) || config.max_refinements < 0 || !(config.alpha_min > 0) ||
-      !(config.alpha_min <= 1) || config.equilibrium_max_iterations < 1 || !(config.equilibrium_tolerance > 0)) {
+      !(config.alpha_min <= 1) || config.equilibrium_max_iterations < 1 || !(config.equilibrium_tolerance > 0) ||
+      config.steps_per_frame < 1 || config.steps_per_frame > max_steps_per_frame) {
     return Status::invalid_argument;
   }
   if (ws.curve_capacity < config.grid_points + config.max_refinements || ws.grid_capacity < config.grid_points) {
@@ -49,7 +50,9 @@ Status check_inputs(const MsmModel<Dim, Scalar>& model, const ObservationSequenc
   return free_particles > 0 ? Status::ok : Status::no_free_particles;
 }
 
-// Driven targets for frame `k`: the particle's observation there, else its last target.
+// Driven targets for frame `k`: the particle's observation there, else its last target. Also
+// records where each target starts the interval from frame k - 1: its previous target, or where
+// the particle is when its window has just opened.
 template <int Dim, typename Scalar>
 int gather_targets(const ObservationSequence<Dim, Scalar>& obs, int k, const MsmState<Dim, Scalar>& state,
                    DeformabilityWorkspace<Dim, Scalar>& ws) noexcept {
@@ -63,6 +66,7 @@ int gather_targets(const ObservationSequence<Dim, Scalar>& obs, int k, const Msm
     }
     if (ws.window_active[w] == 0) ws.held[w] = state.position[window.id];
     ws.window_active[w] = 1;
+    ws.interval_start[count] = ws.held[w];
     if (obs.observed(k, window.id)) ws.held[w] = obs.point(k, window.id);
     ws.target_ids[count] = window.id;
     ws.targets[count] = ws.held[w];
@@ -125,9 +129,34 @@ void accumulate_frame(const MsmModel<Dim, Scalar>& model, const ObservationSeque
   error.count += used;
 }
 
+// Steps the model over one frame interval of length dt toward the gathered targets: one step
+// straight to them, or `steps` steps toward targets interpolated from the interval's start.
+template <int Dim, typename Scalar>
+void step_frame_interval(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>& params, Scalar dt,
+                         int target_count, int steps, DeformabilityWorkspace<Dim, Scalar>& ws) noexcept {
+  MsmStepInput<Dim, Scalar> input;
+  input.driven.count = target_count;
+  input.driven.ids = ws.target_ids;
+  if (steps == 1) {
+    input.dt = dt;
+    input.driven.positions = ws.targets;
+    (void)msm_step(model, params, input, ws.state);
+    return;
+  }
+  input.dt = dt / static_cast<Scalar>(steps);
+  input.driven.positions = ws.step_targets;
+  for (int j = 1; j <= steps; ++j) {
+    const Scalar share = static_cast<Scalar>(j) / static_cast<Scalar>(steps);
+    for (int c = 0; c < target_count; ++c) {
+      ws.step_targets[c] = ws.interval_start[c] + (ws.targets[c] - ws.interval_start[c]) * share;
+    }
+    (void)msm_step(model, params, input, ws.state);
+  }
+}
+
 template <int Dim, typename Scalar>
 void run_trajectory(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>& params,
-                    const ObservationSequence<Dim, Scalar>& obs, bool observed_everywhere,
+                    const ObservationSequence<Dim, Scalar>& obs, int steps_per_frame, bool observed_everywhere,
                     DeformabilityWorkspace<Dim, Scalar>& ws, TrajectoryError& error) noexcept {
   MsmState<Dim, Scalar>& state = ws.state;
   msm_state_reset(model, state);
@@ -138,12 +167,9 @@ void run_trajectory(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Sca
   }
   (void)gather_targets(obs, 0, state, ws);
   for (int k = 1; k < obs.frame_count; ++k) {
-    MsmStepInput<Dim, Scalar> input;
-    input.dt = static_cast<Scalar>(obs.times_s[k] - obs.times_s[k - 1]);
-    input.driven.count = gather_targets(obs, k, state, ws);
-    input.driven.ids = ws.target_ids;
-    input.driven.positions = ws.targets;
-    (void)msm_step(model, params, input, state);
+    const auto dt = static_cast<Scalar>(obs.times_s[k] - obs.times_s[k - 1]);
+    const int target_count = gather_targets(obs, k, state, ws);
+    step_frame_interval(model, params, dt, target_count, steps_per_frame, ws);
     if (observed_everywhere) {
       accumulate_frame<true>(model, obs, k, state, ws.residual_sum, ws.residual_samples, error);
     } else {
@@ -233,7 +259,7 @@ Status evaluate_error(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, S
                       TrajectoryError& error) noexcept {
   error = TrajectoryError{};
   if (config.mode == FitMode::trajectory) {
-    run_trajectory(model, params, obs, observed_everywhere, ws, error);
+    run_trajectory(model, params, obs, config.steps_per_frame, observed_everywhere, ws, error);
   } else {
     run_final(model, params, obs, config, ws, error);
   }
@@ -497,6 +523,7 @@ Status search_beta(const MsmModel<Dim, Scalar>& model, MsmParams<Dim, Scalar> pa
       const double icc = std::clamp((share - 1.0 / per_particle) / (1.0 - 1.0 / per_particle), 0.0, 1.0);
       design_effect = 1.0 + (per_particle - 1.0) * icc;
       result.residual_correlation = icc;
+      result.design_effect = design_effect;
     }
   }
   result.msm_beta_std = least_squares_std(best.error.sum_squares, curvature, scalars) * std::sqrt(design_effect);
@@ -554,6 +581,8 @@ Status deformability_workspace_init(Arena& arena, const MsmModel<Dim, Scalar>& m
   ws.target_ids = arena.carve<int>(driven);
   ws.targets = arena.carve<Vec>(driven);
   ws.held = arena.carve<Vec>(driven);
+  ws.interval_start = arena.carve<Vec>(driven);
+  ws.step_targets = arena.carve<Vec>(driven);
   ws.window_active = arena.carve<std::uint8_t>(driven);
   ws.previous = arena.carve<Vec>(static_cast<std::size_t>(model.particle_count));
   ws.residual_sum = arena.carve<Eigen::Matrix<double, Dim, 1>>(static_cast<std::size_t>(model.particle_count));

@@ -31,11 +31,17 @@ EstimateCommand::EstimateCommand(CLI::App& parent) {
   app_->add_option("--mode", mode_, "'trajectory': simulate every frame; 'final': match the final equilibrium only")
       ->type_name("final|trajectory")
       ->capture_default_str();
-  auto* alpha_flag = app_->add_flag("--alpha", estimate_alpha_, "Also estimate msm_alpha (trajectory mode only)");
-  app_->add_option("--msm-alpha", msm_alpha_, "msm_alpha held fixed while estimating msm_beta, in (0, 1]")
-      ->type_name("A")
-      ->capture_default_str()
-      ->excludes(alpha_flag);
+  auto* alpha_option =
+      app_->add_option("--alpha", alpha_,
+                       "msm_alpha: 'auto' (default) fits it with msm_beta when the recording determines it (BIC), "
+                       "'fit' (also a bare --alpha) always, 'fixed=A' holds it at A in (0, 1] (the old default A = 1)")
+          ->type_name("auto|fit|fixed=A")
+          ->expected(0, 1);
+  app_->add_option("--msm-alpha", msm_alpha_, "Same as --alpha fixed=A")->type_name("A")->excludes(alpha_option);
+  app_->add_option("--steps-per-frame", steps_per_frame_,
+                   "MSM steps per frame interval: 'auto' (default) chooses 1-4 with msm_alpha (BIC), or N in 1..64")
+      ->type_name("auto|N")
+      ->capture_default_str();
   app_->add_option("--grid", grid_points_, "Grid points over msm_beta in [0, 1] before refinement (>= 3)")
       ->type_name("N")
       ->capture_default_str();
@@ -49,13 +55,36 @@ int EstimateCommand::run() const {
   } catch (const std::invalid_argument& e) {
     throw UsageError(e.what());
   }
-  if (estimate_alpha_ && options.mode != FitMode::trajectory) throw UsageError("--alpha needs --mode trajectory");
-  if (!(msm_alpha_ > 0.0 && msm_alpha_ <= 1.0)) throw UsageError("--msm-alpha must be in (0, 1]");
+  try {
+    host::parse_alpha_choice(alpha_, options.alpha, options.msm_alpha);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  if (app_->count("--msm-alpha") > 0) {
+    if (!(msm_alpha_ > 0.0 && msm_alpha_ <= 1.0)) throw UsageError("--msm-alpha must be in (0, 1]");
+    options.alpha = host::AlphaMode::fixed;
+    options.msm_alpha = msm_alpha_;
+  }
+  if (steps_per_frame_ != "auto") {
+    std::size_t used = 0;
+    int steps = 0;
+    try {
+      steps = std::stoi(steps_per_frame_, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != steps_per_frame_.size() || steps < 1 || steps > max_steps_per_frame) {
+      throw UsageError("--steps-per-frame must be 'auto' or a whole number in 1.." +
+                       std::to_string(max_steps_per_frame) + ", not '" + steps_per_frame_ + "'");
+    }
+    options.steps_per_frame = steps;
+  }
+  if (options.alpha == host::AlphaMode::fitted && options.mode != FitMode::trajectory) {
+    throw UsageError("--alpha fit needs --mode trajectory");
+  }
   if (grid_points_ < 3 || grid_points_ > max_grid_points) {
     throw UsageError("--grid must be between 3 and " + std::to_string(max_grid_points));
   }
-  options.estimate_alpha = estimate_alpha_;
-  options.msm_alpha = msm_alpha_;
   options.grid_points = grid_points_;
 
   const host::Recording recording = host::read_recording(recording_);

@@ -21,7 +21,8 @@ class EstimateCommand {
   std::string recording_;
   std::string json_path_;
   std::string mode_ = "trajectory";
-  bool estimate_alpha_ = false;
+  std::string alpha_ = "auto";
+  std::string steps_per_frame_ = "auto";
   double msm_alpha_ = 1.0;
   int grid_points_ = 11;
   bool quiet_ = false;

@@ -110,7 +110,6 @@ std::string format_estimate_summary(const host::Recording& recording, const host
                                     const host::EstimateReport& report) {
   const DeformabilityResult& r = report.result;
   const std::string& unit = recording.length_unit;
-  const bool alpha_estimated = options.estimate_alpha && options.mode == FitMode::trajectory;
   std::string text;
   text += format("recording   %s: %d particles, %d frames, %dD, %s\n", recording.name.c_str(), recording.particle_count,
                  recording.frame_count(), recording.dimension, unit.c_str());
@@ -120,12 +119,15 @@ std::string format_estimate_summary(const host::Recording& recording, const host
     text += format("            (1 sd: %.2g from the error curve, %.2g from input noise of %.3g %s)\n",
                    report.msm_beta_std_curvature, report.msm_beta_std_input, report.noise_std, unit.c_str());
   }
-  text += format("msm_alpha   %.3f (%s)\n", r.msm_alpha, alpha_estimated ? "estimated" : "given");
+  text += format("msm_alpha   %.3f (%s)\n", r.msm_alpha, report.baseline.alpha_fitted() ? "fitted" : "held");
+  text += "baseline    " + report.baseline.reason + "\n";
   text += format("unique min  %s\n", r.unique_minimum ? "yes" : "no");
   text += format("rms         %.3g %s (mean error %.3g %s over %ld residuals)\n", r.rms, unit.c_str(), r.error,
                  unit.c_str(), r.residual_count);
-  text += format("model       %d clusters, time step %.4g s, 1 step per frame, rest from %d still frame%s\n",
-                 report.cluster_count, report.frame_interval_s, report.rest_frames, report.rest_frames == 1 ? "" : "s");
+  const int steps = report.baseline.steps_per_frame();
+  text += format("model       %d clusters, time step %.4g s, %d step%s per frame, rest from %d still frame%s\n",
+                 report.cluster_count, report.frame_interval_s / steps, steps, steps == 1 ? "" : "s",
+                 report.rest_frames, report.rest_frames == 1 ? "" : "s");
   text += format("runtime     %.2f s (%d error evaluations)\n", report.runtime_s, r.evaluations);
   for (const std::string& warning : estimate_warnings(report)) text += "warning: " + warning + "\n";
   text += "\n" + format_error_curve(report, unit, 11);

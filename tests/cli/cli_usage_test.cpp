@@ -49,7 +49,7 @@ TEST(cli_usage, UnknownOptionIsOneLineAndExitsTwo) {
 TEST(cli_usage, CommandHelpShowsItsOptions) {
   const CommandResult estimate = run_pliant("estimate --help");
   EXPECT_EQ(estimate.status, 0);
-  for (const char* option : {"--json", "--mode", "--alpha", "--msm-alpha", "--grid", "--quiet"}) {
+  for (const char* option : {"--json", "--mode", "--alpha", "--msm-alpha", "--steps-per-frame", "--grid", "--quiet"}) {
     EXPECT_TRUE(contains(estimate.out, option)) << option;
   }
   const CommandResult simulate = run_pliant("simulate --help");
@@ -84,6 +84,16 @@ TEST(cli_usage, BadEstimateOptionValuesExitTwoWithOneLine) {
       {"--msm-alpha 1.5", "--msm-alpha"},
       {"--alpha --mode final", "--alpha"},
       {"--alpha --msm-alpha 0.5", "--alpha"},
+      {"--alpha sometimes", "--alpha"},
+      {"--alpha fixed=0", "--alpha"},
+      {"--alpha fixed=2", "--alpha"},
+      {"--alpha fixed=x", "--alpha"},
+      {"--alpha fit --mode final", "--alpha"},
+      {"--steps-per-frame 0", "--steps-per-frame"},
+      {"--steps-per-frame 65", "--steps-per-frame"},
+      {"--steps-per-frame 2.5", "--steps-per-frame"},
+      {"--steps-per-frame many", "--steps-per-frame"},
+      {"--steps-per-frame -1", "--steps-per-frame"},
   };
   for (const BadOption& c : cases) {
     const CommandResult r = run_pliant("estimate " + quoted(dir / "rec") + " " + c.arguments);

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
 #include <memory>
 #include <random>
 #include <vector>
@@ -37,17 +40,17 @@ struct StagedProgress {
 
 // Spread of msm_beta when the inputs the model is built on (rest shape, driven tracks) are
 // perturbed by the measured noise: a parametric bootstrap of the input-noise contribution.
+// `options` holds msm_alpha fixed at the value to refit with; the refits report progress as the
+// stages after `first_stage` of `staged`.
 template <int Dim>
 double input_noise_std(const Recording& recording, const EstimateOptions& options, const HostMsmModel<Dim>& base,
-                       double noise_std) {
+                       double noise_std, StagedProgress& staged, int first_stage) {
   if (options.input_noise_samples < 2 || !(noise_std > 0)) return 0.0;
   EstimateOptions refit = options;
   refit.input_noise_samples = 0;
   refit.grid_points = 6;
   refit.tolerance = 2e-3;
-  refit.estimate_alpha = false;
   refit.setup.rest = RestSource::first_frame;
-  StagedProgress staged{options.progress, options.progress_context, 0, options.input_noise_samples + 1};
   if (options.progress != nullptr) {
     refit.progress = &StagedProgress::forward;
     refit.progress_context = &staged;
@@ -57,7 +60,7 @@ double input_noise_std(const Recording& recording, const EstimateOptions& option
   const double rest_sigma = noise_std / std::sqrt(static_cast<double>(base.rest_frames));
   std::vector<double> betas;
   for (int sample = 0; sample < options.input_noise_samples; ++sample) {
-    staged.stage = sample + 1;
+    staged.stage = first_stage + sample;
     Recording perturbed = recording;
     perturbed.rest_positions = base.rest;
     for (double& x : perturbed.rest_positions) x += rest_sigma * normal(rng);
@@ -89,37 +92,172 @@ double input_noise_std(const Recording& recording, const EstimateOptions& option
   return std::sqrt(squares / static_cast<double>(betas.size() - 1));
 }
 
+// One fit of msm_beta, with msm_alpha fitted too or held at `alpha`, on an already built model.
+template <int Dim>
+struct MsmFit {
+  DeformabilityResult result;
+  std::vector<double> curve_beta;
+  std::vector<double> curve_error;
+};
+
+template <int Dim>
+MsmFit<Dim> fit_msm(const Recording& recording, const EstimateOptions& options, const HostMsmModel<Dim>& model,
+                    int steps_per_frame, bool fit_alpha, double alpha, StagedProgress* progress) {
+  DeformabilityConfig config;
+  config.mode = options.mode;
+  config.estimate_alpha = fit_alpha;
+  config.steps_per_frame = steps_per_frame;
+  config.grid_points = options.grid_points;
+  config.tolerance = options.tolerance;
+  if (progress != nullptr && progress->callback != nullptr) {
+    config.progress = &StagedProgress::forward;
+    config.progress_context = progress;
+  }
+  const int driven = static_cast<int>(model.driven.size());
+  const std::size_t bytes = deformability_workspace_size(model.model, driven, config);
+  auto block = std::make_unique<unsigned char[]>(bytes);
+  Arena arena(block.get(), bytes);
+  DeformabilityWorkspace<Dim, double> workspace;
+  require_ok(deformability_workspace_init(arena, model.model, driven, config, workspace), "estimator workspace");
+  MsmFit<Dim> fit;
+  const ObservationSequence<Dim, double> obs = observations_of<Dim>(recording, model);
+  const Status status =
+      estimate_deformability(model.model, base_params<Dim>(recording, alpha), obs, config, workspace, fit.result);
+  if (status != Status::ok) throw std::runtime_error(explain(status));
+  fit.curve_beta.assign(workspace.curve_beta, workspace.curve_beta + fit.result.curve_count);
+  fit.curve_error.assign(workspace.curve_error, workspace.curve_error + fit.result.curve_count);
+  return fit;
+}
+
+// The baseline selection (docs/estimation.md). Every variant is scored by the Bayesian
+// information criterion with Gaussian residuals of unknown variance,
+//   BIC = n_eff ln(RSS / n) + k ln(n_eff),
+// k = 1 (msm_beta) or 2 (and msm_alpha). Residuals of one particle are correlated over time, so
+// they count by their effective number n_eff = n / deff, deff the design effect of the variant
+// that fits best (the one whose residuals are closest to plain noise); the same n_eff for every
+// variant keeps the scores comparable. Steps per frame is a discrete choice of the model's form,
+// not a fitted parameter. Ties go to the earlier (simpler) variant.
+template <int Dim>
+void score_candidates(const std::vector<DeformabilityResult>& results, BaselineChoice& choice) {
+  std::size_t best_fit = 0;
+  for (std::size_t i = 1; i < results.size(); ++i) {
+    if (results[i].rms < results[best_fit].rms) best_fit = i;
+  }
+  const double scalars = static_cast<double>(results[best_fit].residual_count) * Dim;
+  const double n_eff = std::max(2.0, scalars / std::max(1.0, results[best_fit].design_effect));
+  choice.effective_residuals = n_eff;
+  constexpr double floor = 1e-300;  // a noise-free fit: its log stays finite
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    BaselineCandidate& c = choice.candidates[i];
+    const double parameters = c.alpha_fitted ? 2.0 : 1.0;
+    c.bic = n_eff * std::log(std::max(c.rms * c.rms, floor)) + parameters * std::log(n_eff);
+  }
+  choice.chosen = 0;
+  for (std::size_t i = 1; i < results.size(); ++i) {
+    if (choice.candidates[i].bic < choice.candidates[static_cast<std::size_t>(choice.chosen)].bic) {
+      choice.chosen = static_cast<int>(i);
+    }
+  }
+}
+
+// A fit whose rms residual is within this factor of the position noise measured on the fixed
+// particles leaves nothing systematic for a nuisance parameter to explain: there, fitting
+// msm_alpha only trades it against the noise of the rest shape and the tool track (a lagging
+// model filters the tool's noise) and biases msm_beta. The factor allows for that noise
+// propagating through the model built on them.
+constexpr double kExplainedByNoise = 1.5;
+
+bool explained_by_noise(double rms, double noise_std) { return noise_std > 0 && rms <= kExplainedByNoise * noise_std; }
+
+std::string choice_reason(const BaselineChoice& choice, bool compared_alpha, bool compared_steps) {
+  const BaselineCandidate& kept = choice.candidates[static_cast<std::size_t>(choice.chosen)];
+  // The runner-up: the best-scoring variant other than the one kept.
+  const BaselineCandidate* next = nullptr;
+  for (std::size_t i = 0; i < choice.candidates.size(); ++i) {
+    if (static_cast<int>(i) == choice.chosen) continue;
+    if (next == nullptr || choice.candidates[i].bic < next->bic) next = &choice.candidates[i];
+  }
+  char text[320];
+  std::snprintf(text, sizeof text, "%s at %.3f, %d step%s per frame", kept.alpha_fitted ? "fitted" : "held",
+                kept.msm_alpha, kept.steps_per_frame, kept.steps_per_frame == 1 ? "" : "s");
+  std::string reason = text;
+  if (next == nullptr) return reason;
+  const char* what = compared_alpha && compared_steps ? "msm_alpha and steps per frame"
+                     : compared_alpha                 ? "msm_alpha"
+                                                      : "steps per frame";
+  std::snprintf(text, sizeof text,
+                ": chosen over %zu variants of %s by BIC, %.1f below the next best (%s, %d per frame) over %.0f "
+                "effective residuals",
+                choice.candidates.size(), what, next->bic - kept.bic, next->alpha_fitted ? "fitted" : "held",
+                next->steps_per_frame, choice.effective_residuals);
+  return reason + text;
+}
+
+// Fits the baseline variants `options` asks for and keeps the best. Automatic steps per frame
+// go up from 1 while the best score improves (more steps cost more evaluations).
+template <int Dim>
+MsmFit<Dim> fit_baseline(const Recording& recording, const EstimateOptions& options, const HostMsmModel<Dim>& model,
+                         BaselineChoice& choice, StagedProgress& progress) {
+  const bool trajectory = options.mode == FitMode::trajectory;
+  const bool alpha_auto = trajectory && options.alpha == AlphaMode::automatic;
+  const bool alpha_fit = trajectory && options.alpha == AlphaMode::fitted;
+  const bool steps_auto = trajectory && options.steps_per_frame == 0;
+  std::vector<MsmFit<Dim>> fits;
+  std::vector<DeformabilityResult> results;
+  auto add = [&](int steps, bool fit_alpha) {
+    fits.push_back(fit_msm<Dim>(recording, options, model, steps, fit_alpha, options.msm_alpha, &progress));
+    ++progress.stage;
+    const DeformabilityResult& r = fits.back().result;
+    results.push_back(r);
+    choice.candidates.push_back({steps, fit_alpha, r.msm_alpha, r.msm_beta, r.rms, 0.0});
+  };
+  const int first_steps = trajectory && options.steps_per_frame > 0 ? options.steps_per_frame : 1;
+  const int last_steps = steps_auto ? max_auto_steps_per_frame : first_steps;
+  for (int steps = first_steps; steps <= last_steps; ++steps) {
+    if (!alpha_fit) add(steps, false);
+    if (steps == first_steps && !alpha_fit && (alpha_auto || steps_auto) &&
+        explained_by_noise(results.front().rms, model.noise_std)) {
+      score_candidates<Dim>(results, choice);
+      char text[200];
+      std::snprintf(text, sizeof text,
+                    "held at %.3f, %d step%s per frame: it fits to within %.1f times the measured noise (rms %.3g, "
+                    "noise %.3g), nothing left for msm_alpha or steps per frame to explain",
+                    results.front().msm_alpha, first_steps, first_steps == 1 ? "" : "s", kExplainedByNoise,
+                    results.front().rms, model.noise_std);
+      choice.reason = text;
+      return std::move(fits.front());
+    }
+    if (alpha_auto || alpha_fit) add(steps, true);
+    score_candidates<Dim>(results, choice);
+  }
+  if (!trajectory) {
+    choice.reason = "held: the final equilibrium does not depend on msm_alpha or steps per frame";
+  } else if (choice.candidates.size() == 1) {
+    choice.reason = std::string(options.alpha == AlphaMode::fitted ? "fitted" : "held") + " as asked (--alpha " +
+                    alpha_mode_name(options.alpha) + "), " + std::to_string(first_steps) + " step" +
+                    (first_steps == 1 ? "" : "s") + " per frame";
+  } else {
+    choice.reason = choice_reason(choice, alpha_auto, steps_auto);
+  }
+  return std::move(fits[static_cast<std::size_t>(choice.chosen)]);
+}
+
 template <int Dim>
 EstimateReport run(const Recording& recording, const EstimateOptions& options) {
   const auto started = std::chrono::steady_clock::now();
   auto model = build_msm_model<Dim>(recording, options.setup);
-  DeformabilityConfig config;
-  config.mode = options.mode;
-  config.estimate_alpha = options.estimate_alpha;
-  config.grid_points = options.grid_points;
-  config.tolerance = options.tolerance;
-  StagedProgress staged{options.progress, options.progress_context, 0, std::max(1, options.input_noise_samples + 1)};
-  if (options.progress != nullptr && options.input_noise_samples >= 2) {
-    config.progress = &StagedProgress::forward;
-    config.progress_context = &staged;
-  } else {
-    config.progress = options.progress;
-    config.progress_context = options.progress_context;
-  }
-  const int driven = static_cast<int>(model->driven.size());
-  const std::size_t bytes = deformability_workspace_size(model->model, driven, config);
-  auto block = std::make_unique<unsigned char[]>(bytes);
-  Arena arena(block.get(), bytes);
-  DeformabilityWorkspace<Dim, double> workspace;
-  require_ok(deformability_workspace_init(arena, model->model, driven, config, workspace), "estimator workspace");
+  const bool trajectory = options.mode == FitMode::trajectory;
+  const int alpha_variants = trajectory && options.alpha == AlphaMode::automatic ? 2 : 1;
+  const int step_variants = trajectory && options.steps_per_frame == 0 ? max_auto_steps_per_frame : 1;
+  const int noise_stages = options.input_noise_samples >= 2 ? options.input_noise_samples : 0;
+  StagedProgress staged{options.progress, options.progress_context, 0, alpha_variants * step_variants + noise_stages};
 
   EstimateReport report;
-  const ObservationSequence<Dim, double> obs = observations_of<Dim>(recording, *model);
-  const Status status = estimate_deformability(model->model, base_params<Dim>(recording, options.msm_alpha), obs,
-                                               config, workspace, report.result);
-  if (status != Status::ok) throw std::runtime_error(explain(status));
-  report.curve_beta.assign(workspace.curve_beta, workspace.curve_beta + report.result.curve_count);
-  report.curve_error.assign(workspace.curve_error, workspace.curve_error + report.result.curve_count);
+  MsmFit<Dim> fit = fit_baseline<Dim>(recording, options, *model, report.baseline, staged);
+  const int fits = staged.stage;
+  report.result = fit.result;
+  report.curve_beta = std::move(fit.curve_beta);
+  report.curve_error = std::move(fit.curve_error);
   report.cluster_count = model->model.cluster_count;
   report.rest_frames = model->rest_frames;
   report.spacing = model->model.spacing;
@@ -129,7 +267,13 @@ EstimateReport run(const Recording& recording, const EstimateOptions& options) {
   // Without fixed particles to measure noise on, the fit's residual is a conservative stand-in.
   report.noise_std = model->noise_std > 0 ? model->noise_std : report.result.rms;
   report.msm_beta_std_curvature = report.result.msm_beta_std;
-  report.msm_beta_std_input = input_noise_std<Dim>(recording, options, *model, report.noise_std);
+  // The input-noise refits hold msm_alpha at the value chosen above: they measure the spread of
+  // msm_beta within the model the fit settled on.
+  EstimateOptions refit = options;
+  refit.alpha = AlphaMode::fixed;
+  refit.msm_alpha = report.result.msm_alpha;
+  refit.steps_per_frame = report.baseline.steps_per_frame();
+  report.msm_beta_std_input = input_noise_std<Dim>(recording, refit, *model, report.noise_std, staged, fits);
   report.msm_beta_std = std::hypot(report.msm_beta_std_curvature, report.msm_beta_std_input);
   report.runtime_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return report;
@@ -143,6 +287,43 @@ double finite_or(double value, double fallback) { return std::isfinite(value) ? 
 EstimateReport estimate_recording(const Recording& recording, const EstimateOptions& options) {
   if (recording.frame_count() < 2) throw std::runtime_error("the recording has fewer than two frames");
   return recording.dimension == 2 ? run<2>(recording, options) : run<3>(recording, options);
+}
+
+const char* alpha_mode_name(AlphaMode mode) {
+  switch (mode) {
+    case AlphaMode::automatic: return "auto";
+    case AlphaMode::fitted: return "fit";
+    case AlphaMode::fixed: return "fixed";
+  }
+  return "auto";
+}
+
+void parse_alpha_choice(const std::string& text, AlphaMode& mode, double& held_alpha) {
+  if (text == "auto") {
+    mode = AlphaMode::automatic;
+    return;
+  }
+  if (text == "fit" || text.empty()) {
+    mode = AlphaMode::fitted;
+    return;
+  }
+  const std::string prefix = "fixed";
+  if (text.compare(0, prefix.size(), prefix) == 0) {
+    double value = 1.0;
+    if (text.size() > prefix.size()) {
+      const std::string number = text.substr(prefix.size() + 1);
+      char* end = nullptr;
+      value = number.empty() || text[prefix.size()] != '=' ? -1.0 : std::strtod(number.c_str(), &end);
+      if (end == nullptr || *end != '\0') value = -1.0;
+    }
+    if (!(value > 0.0 && value <= 1.0)) {
+      throw std::invalid_argument("--alpha fixed=A needs A in (0, 1], not '" + text + "'");
+    }
+    mode = AlphaMode::fixed;
+    held_alpha = value;
+    return;
+  }
+  throw std::invalid_argument("--alpha must be 'auto', 'fit' or 'fixed=A', not '" + text + "'");
 }
 
 const char* fit_mode_name(FitMode mode) { return mode == FitMode::trajectory ? "trajectory" : "final"; }
@@ -170,8 +351,8 @@ nlohmann::json estimate_json(const Recording& recording, const EstimateOptions& 
   };
   // Choices that change the fitted value (PHYSICS.md): recorded so results are comparable.
   out["model_options"] = {
-      {"time_step_s", report.frame_interval_s},
-      {"steps_per_frame", 1},
+      {"time_step_s", report.frame_interval_s / report.baseline.steps_per_frame()},
+      {"steps_per_frame", report.baseline.steps_per_frame()},
       {"clusters", report.cluster_count},
       {"cluster_layout", options.setup.clusters.layout == ClusterLayout::radius      ? "radius"
                          : options.setup.clusters.layout == ClusterLayout::k_nearest ? "k_nearest"
@@ -180,9 +361,23 @@ nlohmann::json estimate_json(const Recording& recording, const EstimateOptions& 
       {"driven_mass_factor", options.setup.driven_mass_factor},
       {"rest_source", options.setup.rest == RestSource::still_frames ? "still_frames" : "first_frame"},
       {"rest_frames", report.rest_frames},
-      {"msm_alpha_estimated", options.estimate_alpha && options.mode == FitMode::trajectory},
+      {"msm_alpha_estimated", report.baseline.alpha_fitted()},
+      {"msm_alpha_mode", alpha_mode_name(options.alpha)},
+      {"steps_per_frame_mode", options.steps_per_frame == 0 ? "auto" : "fixed"},
+      {"baseline_reason", report.baseline.reason},
       {"gravity_declared", recording.gravity.has_value()},
   };
+  nlohmann::json candidates = nlohmann::json::array();
+  for (const BaselineCandidate& c : report.baseline.candidates) {
+    candidates.push_back({{"steps_per_frame", c.steps_per_frame},
+                          {"msm_alpha_fitted", c.alpha_fitted},
+                          {"msm_alpha", c.msm_alpha},
+                          {"msm_beta", c.msm_beta},
+                          {"rms", c.rms},
+                          {"bic", finite_or(c.bic, -1e300)}});
+  }
+  out["model_options"]["baseline_candidates"] = candidates;
+  out["model_options"]["effective_residuals"] = report.baseline.effective_residuals;
   out["diagnostics"] = {
       {"error", r.error},
       {"residual_count", r.residual_count},

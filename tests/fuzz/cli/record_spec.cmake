@@ -7,7 +7,7 @@ add_executable(record_spec_fuzz
   ${pliant_root}/host/cli/record_device_spec.cpp)
 target_include_directories(record_spec_fuzz PRIVATE ${pliant_root}/host/cli)
 target_compile_options(record_spec_fuzz PRIVATE
-  -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer -g)
+  -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer)
 target_link_options(record_spec_fuzz PRIVATE -fsanitize=fuzzer,address,undefined)
 pliant_set_warnings(record_spec_fuzz)
 set(PLIANT_RECORD_SPEC_FUZZ_BUILT 1 CACHE INTERNAL "record_spec_fuzz defined (read by .ci/fuzz.d/record.sh)")

@@ -10,6 +10,6 @@ add_executable(libcamera_conversion_fuzz
 target_include_directories(libcamera_conversion_fuzz PRIVATE
   ${libcamera_driver_root}/src ${libcamera_driver_root}/include ${CMAKE_CURRENT_SOURCE_DIR}/../../hal/include)
 target_compile_options(libcamera_conversion_fuzz PRIVATE
-  -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer -g)
+  -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer)
 target_link_options(libcamera_conversion_fuzz PRIVATE -fsanitize=fuzzer,address,undefined)
 pliant_set_warnings(libcamera_conversion_fuzz)

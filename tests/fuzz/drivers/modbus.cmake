@@ -12,7 +12,7 @@ foreach(fuzzer modbus_robotiq_fuzz modbus_ft300_stream_fuzz)
   target_include_directories(${fuzzer} PRIVATE
     ${modbus_driver_root}/include ${CMAKE_CURRENT_SOURCE_DIR}/../../hal/include)
   target_compile_options(${fuzzer} PRIVATE
-    -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer -g)
+    -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer)
   target_link_options(${fuzzer} PRIVATE -fsanitize=fuzzer,address,undefined)
   pliant_set_warnings(${fuzzer})
 endforeach()

@@ -8,6 +8,6 @@ add_executable(opencv_sequence_fuzz
   ${opencv_driver_root}/src/image_sequence.cpp)
 target_include_directories(opencv_sequence_fuzz PRIVATE ${opencv_driver_root}/src)
 target_compile_options(opencv_sequence_fuzz PRIVATE
-  -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer -g)
+  -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer)
 target_link_options(opencv_sequence_fuzz PRIVATE -fsanitize=fuzzer,address,undefined)
 pliant_set_warnings(opencv_sequence_fuzz)

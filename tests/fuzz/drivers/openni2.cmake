@@ -6,7 +6,7 @@
 #   openni2_depth_fuzz  depth frames as the driver sees them: arbitrary sizes, strides, scales,
 #                       intrinsics and buffers into copy_depth_image and depth_to_points
 set(openni2_dir ${pliant_root}/drivers/openni2)
-set(openni2_fuzz_options -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer -g)
+set(openni2_fuzz_options -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer)
 foreach(fuzzer openni2_oni_fuzz openni2_depth_fuzz)
   if(fuzzer STREQUAL "openni2_oni_fuzz")
     set(openni2_fuzz_source ${openni2_dir}/src/oni_file.cpp)

@@ -2,7 +2,7 @@
 # is built): the pure decoders, and the two sensors' read path on a scripted bus. The driver and
 # hal sources are compiled in with the fuzzer and sanitizer instrumentation.
 set(socketcan_dir ${pliant_root}/drivers/socketcan)
-set(socketcan_fuzz_options -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer -g)
+set(socketcan_fuzz_options -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer)
 
 add_executable(socketcan_decoder_fuzz
   drivers/socketcan_decoder_fuzz.cpp

@@ -20,6 +20,6 @@ target_link_libraries(vision_depth_fuzz PRIVATE PNG::PNG Eigen3::Eigen)
 # Lets the decoder skip chunk CRCs in this build only, so that mutations reach the image data.
 target_compile_definitions(vision_depth_fuzz PRIVATE FUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION)
 target_compile_options(vision_depth_fuzz PRIVATE
-  -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer -g)
+  -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer)
 target_link_options(vision_depth_fuzz PRIVATE -fsanitize=fuzzer,address,undefined)
 pliant_set_warnings(vision_depth_fuzz)

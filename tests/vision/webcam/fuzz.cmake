@@ -13,7 +13,7 @@ if(OpenCV_FOUND)
   target_include_directories(webcam_options_fuzz PRIVATE ${pliant_webcam_dir}/include)
   target_link_libraries(webcam_options_fuzz PRIVATE opencv_core opencv_imgproc opencv_imgcodecs opencv_video)
   target_compile_options(webcam_options_fuzz PRIVATE
-    -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer -g)
+    -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer)
   target_link_options(webcam_options_fuzz PRIVATE -fsanitize=fuzzer,address,undefined)
   pliant_set_warnings(webcam_options_fuzz)
   set(PLIANT_WEBCAM_FUZZ_BUILT 1 CACHE INTERNAL "webcam_options_fuzz is defined (for .ci/fuzz.d/webcam.sh)")

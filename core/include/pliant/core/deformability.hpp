@@ -42,12 +42,17 @@ enum class FitMode : std::uint8_t { final_equilibrium, trajectory };
 /// planned total (the total may grow by a few when refinement needs more). Must not block.
 using ProgressCallback = void (*)(void* context, int done, int planned_total);
 
+inline constexpr int max_steps_per_frame = 64;
+
 struct DeformabilityConfig {
   FitMode mode = FitMode::trajectory;
   int grid_points = 11;     ///< >= 3, uniform over [0, 1]
   double tolerance = 1e-3;  ///< final bracket width on msm_beta
   int max_refinements = 40;
   bool estimate_alpha = false;  ///< also fit msm_alpha in [alpha_min, 1] (trajectory mode only)
+  /// Trajectory mode: MSM steps per frame interval, each of interval / steps_per_frame, with the
+  /// driven targets interpolated linearly between frames. 1..max_steps_per_frame.
+  int steps_per_frame = 1;
   double alpha_min = 0.05;
   int equilibrium_max_iterations = 4000;
   double equilibrium_tolerance = 1e-5;  ///< largest move per iteration, x model spacing
@@ -60,6 +65,7 @@ struct DeformabilityResult {
   double msm_alpha = 1;
   double msm_beta_std = 0;          ///< one standard deviation; +inf when not identifiable
   double residual_correlation = 0;  ///< share of residual variance persisting per particle (icc)
+  double design_effect = 1;         ///< 1 + (m - 1) icc, m residuals per particle: variance inflation
   bool unique_minimum = false;
   double error = 0;         ///< E at the estimate (eq. 15), length unit
   double rms = 0;           ///< rms position residual at the estimate, length unit
@@ -78,6 +84,8 @@ struct DeformabilityWorkspace {
   int* target_ids = nullptr;                              ///< [driven_capacity]
   Vec* targets = nullptr;                                 ///< [driven_capacity]
   Vec* held = nullptr;                                    ///< [driven_capacity] last target per driven window
+  Vec* interval_start = nullptr;                          ///< [driven_capacity] targets' previous-frame positions
+  Vec* step_targets = nullptr;                            ///< [driven_capacity] targets within a frame interval
   std::uint8_t* window_active = nullptr;                  ///< [driven_capacity]
   Vec* previous = nullptr;                                ///< [particle_count] equilibrium convergence check
   Eigen::Matrix<double, Dim, 1>* residual_sum = nullptr;  ///< [particle_count] per-particle sums

@@ -6,6 +6,7 @@
 // std::runtime_error with a one-line message when the recording cannot be estimated.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -18,10 +19,24 @@
 
 namespace pliant::host {
 
+/// How msm_alpha (the shape-matching relaxation) is treated.
+/// - automatic: msm_beta is fitted with msm_alpha held at `msm_alpha` and together with msm_alpha;
+///   the joint fit is kept when the recording determines msm_alpha (the baseline selection below).
+///   The final-equilibrium mode does not depend on msm_alpha and always holds it.
+/// - fitted: msm_beta and msm_alpha together (trajectory mode only).
+/// - fixed: msm_alpha held at `msm_alpha` (the behaviour before automatic was the default).
+enum class AlphaMode : std::uint8_t { automatic, fitted, fixed };
+
+/// Largest MSM steps per frame interval the automatic choice tries.
+inline constexpr int max_auto_steps_per_frame = 4;
+
 struct EstimateOptions {
   FitMode mode = FitMode::trajectory;
-  bool estimate_alpha = false;
-  double msm_alpha = 1.0;  ///< used when msm_alpha is not estimated
+  AlphaMode alpha = AlphaMode::automatic;
+  double msm_alpha = 1.0;  ///< in (0, 1]: the held value (fixed, and the alternative automatic weighs)
+  /// Trajectory mode: MSM steps per frame interval. 0 = chosen by the baseline selection among
+  /// 1..max_auto_steps_per_frame; else held at that value (1..max_steps_per_frame).
+  int steps_per_frame = 0;
   int grid_points = 11;
   double tolerance = 1e-3;
   MsmSetupOptions setup;
@@ -33,8 +48,40 @@ struct EstimateOptions {
   void* progress_context = nullptr;
 };
 
+/// One variant of the baseline model that was fitted: steps per frame and msm_alpha held or fitted.
+struct BaselineCandidate {
+  int steps_per_frame = 1;
+  bool alpha_fitted = false;
+  double msm_alpha = 1;
+  double msm_beta = 0;
+  double rms = 0;  ///< rms position residual per coordinate, length unit
+  double bic = 0;  ///< Bayesian information criterion over the effective residuals (lower is better)
+};
+
+/// How the baseline was chosen: every variant fitted, the one kept, and why (docs/estimation.md).
+struct BaselineChoice {
+  std::vector<BaselineCandidate> candidates;  ///< in the order fitted
+  int chosen = 0;                             ///< index into candidates
+  double effective_residuals = 0;             ///< residual scalars / design effect of the best-fitting variant
+  std::string reason;                         ///< one sentence for people
+  bool alpha_fitted() const {
+    return candidates.empty() ? false : candidates[static_cast<std::size_t>(chosen)].alpha_fitted;
+  }
+  int steps_per_frame() const {
+    return candidates.empty() ? 1 : candidates[static_cast<std::size_t>(chosen)].steps_per_frame;
+  }
+};
+
+/// Human-readable name of a mode ("auto", "fit", "fixed").
+const char* alpha_mode_name(AlphaMode mode);
+
+/// The command-line form: "auto", "fit" (also ""), "fixed" (held at 1) or "fixed=A" with A in
+/// (0, 1]. Sets `mode` and, for fixed, `held_alpha`; throws std::invalid_argument naming the text.
+void parse_alpha_choice(const std::string& text, AlphaMode& mode, double& held_alpha);
+
 struct EstimateReport {
   DeformabilityResult result;
+  BaselineChoice baseline;
   std::vector<double> curve_beta;
   std::vector<double> curve_error;
   int cluster_count = 0;
