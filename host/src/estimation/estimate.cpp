@@ -92,7 +92,7 @@ double input_noise_std(const Recording& recording, const EstimateOptions& option
   return std::sqrt(squares / static_cast<double>(betas.size() - 1));
 }
 
-// One fit of msm_beta, with msm_alpha fitted too or held at `alpha`, on an already built model.
+// One fitted variant: the estimator's result and its error curve.
 template <int Dim>
 struct MsmFit {
   DeformabilityResult result;
@@ -100,6 +100,8 @@ struct MsmFit {
   std::vector<double> curve_error;
 };
 
+// One fit of msm_beta on an already built model, stepping `steps_per_frame` times per frame
+// interval, with msm_alpha fitted too or held at `alpha`.
 template <int Dim>
 MsmFit<Dim> fit_msm(const Recording& recording, const EstimateOptions& options, const HostMsmModel<Dim>& model,
                     int steps_per_frame, bool fit_alpha, double alpha, StagedProgress* progress) {
@@ -193,8 +195,9 @@ std::string choice_reason(const BaselineChoice& choice, bool compared_alpha, boo
   return reason + text;
 }
 
-// Fits the baseline variants `options` asks for and keeps the best. Automatic steps per frame
-// go up from 1 while the best score improves (more steps cost more evaluations).
+// Fits the baseline variants `options` asks for and keeps the best: automatic steps per frame
+// tries 1..max_auto_steps_per_frame, automatic msm_alpha held and fitted at each, unless the
+// first (simplest) variant is explained to the measured noise.
 template <int Dim>
 MsmFit<Dim> fit_baseline(const Recording& recording, const EstimateOptions& options, const HostMsmModel<Dim>& model,
                          BaselineChoice& choice, StagedProgress& progress) {
