@@ -20,8 +20,8 @@ endfunction()
 
 # Glue code (the tests, the command-line front end) is compiled at -O1 in Release builds: it
 # parses options, formats text and calls the libraries, which keep the build type's -O3. This
-# takes about a third off these units' compile time (CLI11 alone costs a unit 7-9 s at -O3) and
-# most of CI's build; the speed that matters is measured by bench/, which keeps -O3.
+# takes about a third off these units' compile time (the CLI11 header alone costs a unit several
+# seconds of code generation at -O3); the speed that matters is measured by bench/, which keeps -O3.
 function(pliant_optimize_for_build_time target)
   target_compile_options(${target} PRIVATE "$<$<CONFIG:Release>:-O1>")
 endfunction()
