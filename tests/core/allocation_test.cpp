@@ -794,6 +794,40 @@ TYPED_TEST(RealTimeAllocation, EstimateWithAlpha) {
   EXPECT_GT(result.evaluations, 5 * config.grid_points);
 }
 
+// Several MSM steps per frame interval (targets interpolated within it) use the workspace only;
+// a count outside 1..max_steps_per_frame is refused before anything runs.
+TYPED_TEST(RealTimeAllocation, EstimateWithStepsPerFrame) {
+  using Scalar = typename TestFixture::FixtureScalar;
+  constexpr int Dim = TestFixture::kFixtureDim;
+  const auto& scene = this->scene_;
+  DeformabilityConfig config;
+  config.mode = FitMode::trajectory;
+  config.steps_per_frame = 3;
+  typename TestFixture::OwnedWorkspace owned;
+  this->make_workspace(config, owned);
+  DeformabilityResult result;
+  Status status = Status::not_initialized;
+  AllocationCounts counts;
+  {
+    AllocationCounter counter;
+    status = estimate_deformability(scene.model, MsmParams<Dim, Scalar>{}, scene.observations, config, owned.workspace,
+                                    result);
+    counts = counter.stop();
+  }
+  EXPECT_NO_HEAP(counts, "estimate_deformability (steps_per_frame 3)");
+  ASSERT_EQ(status, Status::ok);
+  EXPECT_GE(result.msm_beta, 0.0);
+  EXPECT_LE(result.msm_beta, 1.0);
+  EXPECT_TRUE(std::isfinite(result.error));
+  for (int steps : {0, -1, max_steps_per_frame + 1}) {
+    config.steps_per_frame = steps;
+    EXPECT_EQ(estimate_deformability(scene.model, MsmParams<Dim, Scalar>{}, scene.observations, config, owned.workspace,
+                                     result),
+              Status::invalid_argument)
+        << steps;
+  }
+}
+
 TYPED_TEST(RealTimeAllocation, EvaluateDeformabilityError) {
   using Scalar = typename TestFixture::FixtureScalar;
   constexpr int Dim = TestFixture::kFixtureDim;
