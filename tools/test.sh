@@ -20,6 +20,9 @@ jobs=$(nproc)
 export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$root}   # cache hits across clones in other folders
 export CCACHE_MAXSIZE=${CCACHE_MAXSIZE:-12G}     # release, sanitizer, fuzz and cross objects
 export CCACHE_COMPILERCHECK=${CCACHE_COMPILERCHECK:-content}
+# Builds with debug information (sanitize: -g1, fuzz: line tables) would otherwise hash the
+# working directory and miss the cache in every other clone.
+export CCACHE_NOHASHDIR=${CCACHE_NOHASHDIR:-1}
 export CMAKE_GENERATOR=${CMAKE_GENERATOR:-Ninja}   # every configure below, the scripts' included
 
 # Sends every compiler call of every configure below (cross.sh's and fuzz_smoke.sh's included)
