@@ -140,22 +140,23 @@ MsmFit<Dim> fit_msm(const Recording& recording, const EstimateOptions& options, 
 // variant keeps the scores comparable. Steps per frame is a discrete choice of the model's form,
 // not a fitted parameter. Ties go to the earlier (simpler) variant.
 template <int Dim>
-void score_candidates(const std::vector<DeformabilityResult>& results, BaselineChoice& choice) {
+void score_candidates(const std::vector<MsmFit<Dim>>& fits, BaselineChoice& choice) {
   std::size_t best_fit = 0;
-  for (std::size_t i = 1; i < results.size(); ++i) {
-    if (results[i].rms < results[best_fit].rms) best_fit = i;
+  for (std::size_t i = 1; i < fits.size(); ++i) {
+    if (fits[i].result.rms < fits[best_fit].result.rms) best_fit = i;
   }
-  const double scalars = static_cast<double>(results[best_fit].residual_count) * Dim;
-  const double n_eff = std::max(2.0, scalars / std::max(1.0, results[best_fit].design_effect));
+  const DeformabilityResult& best = fits[best_fit].result;
+  const double scalars = static_cast<double>(best.residual_count) * Dim;
+  const double n_eff = std::max(2.0, scalars / std::max(1.0, best.design_effect));
   choice.effective_residuals = n_eff;
   constexpr double floor = 1e-300;  // a noise-free fit: its log stays finite
-  for (std::size_t i = 0; i < results.size(); ++i) {
+  for (std::size_t i = 0; i < fits.size(); ++i) {
     BaselineCandidate& c = choice.candidates[i];
     const double parameters = c.alpha_fitted ? 2.0 : 1.0;
     c.bic = n_eff * std::log(std::max(c.rms * c.rms, floor)) + parameters * std::log(n_eff);
   }
   choice.chosen = 0;
-  for (std::size_t i = 1; i < results.size(); ++i) {
+  for (std::size_t i = 1; i < fits.size(); ++i) {
     if (choice.candidates[i].bic < choice.candidates[static_cast<std::size_t>(choice.chosen)].bic) {
       choice.chosen = static_cast<int>(i);
     }
@@ -206,12 +207,10 @@ MsmFit<Dim> fit_baseline(const Recording& recording, const EstimateOptions& opti
   const bool alpha_fit = trajectory && options.alpha == AlphaMode::fitted;
   const bool steps_auto = trajectory && options.steps_per_frame == 0;
   std::vector<MsmFit<Dim>> fits;
-  std::vector<DeformabilityResult> results;
   auto add = [&](int steps, bool fit_alpha) {
     fits.push_back(fit_msm<Dim>(recording, options, model, steps, fit_alpha, options.msm_alpha, &progress));
     ++progress.stage;
     const DeformabilityResult& r = fits.back().result;
-    results.push_back(r);
     choice.candidates.push_back({steps, fit_alpha, r.msm_alpha, r.msm_beta, r.rms, 0.0});
   };
   const int first_steps = trajectory && options.steps_per_frame > 0 ? options.steps_per_frame : 1;
@@ -219,19 +218,19 @@ MsmFit<Dim> fit_baseline(const Recording& recording, const EstimateOptions& opti
   for (int steps = first_steps; steps <= last_steps; ++steps) {
     if (!alpha_fit) add(steps, false);
     if (steps == first_steps && !alpha_fit && (alpha_auto || steps_auto) &&
-        explained_by_noise(results.front().rms, model.noise_std)) {
-      score_candidates<Dim>(results, choice);
+        explained_by_noise(fits.front().result.rms, model.noise_std)) {
+      score_candidates<Dim>(fits, choice);
       char text[200];
       std::snprintf(text, sizeof text,
                     "held at %.3f, %d step%s per frame: it fits to within %.1f times the measured noise (rms %.3g, "
                     "noise %.3g), nothing left for msm_alpha or steps per frame to explain",
-                    results.front().msm_alpha, first_steps, first_steps == 1 ? "" : "s", kExplainedByNoise,
-                    results.front().rms, model.noise_std);
+                    fits.front().result.msm_alpha, first_steps, first_steps == 1 ? "" : "s", kExplainedByNoise,
+                    fits.front().result.rms, model.noise_std);
       choice.reason = text;
       return std::move(fits.front());
     }
     if (alpha_auto || alpha_fit) add(steps, true);
-    score_candidates<Dim>(results, choice);
+    score_candidates<Dim>(fits, choice);
   }
   if (!trajectory) {
     choice.reason = "held: the final equilibrium does not depend on msm_alpha or steps per frame";
