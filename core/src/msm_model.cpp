@@ -88,8 +88,16 @@ int enumerate_clusters(const MsmModelConfig<Dim, Scalar>& config, double radius_
   switch (cc.layout) {
     case ClusterLayout::radius:
       for (int c = 0; c < n; ++c) {
+        // A particle with no neighbour inside the radius (a sparse spot of a sagged or
+        // irregular rest shape) takes the radius factor times its own nearest-neighbour
+        // distance, up to twice the radius; farther out it stays alone and is rejected.
+        double own_radius_squared = radius_squared;
+        const double nearest = nearest_distance_squared<Dim>(config.rest_positions, n, c);
+        if (n > 1 && nearest > radius_squared && nearest <= 4.0 * radius_squared) {
+          own_radius_squared = cc.radius_factor * cc.radius_factor * nearest * (1.0 + 1e-12);
+        }
         for (int j = 0; j < n; ++j) {
-          if (distance_squared<Dim>(config.rest_positions, c, j) <= radius_squared) visit(c, j);
+          if (distance_squared<Dim>(config.rest_positions, c, j) <= own_radius_squared) visit(c, j);
         }
       }
       return n;

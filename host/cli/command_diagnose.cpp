@@ -28,11 +28,25 @@ DiagnoseCommand::DiagnoseCommand(CLI::App& parent) {
                    "in metres with mesh.vtk)")
       ->type_name("msm|fem")
       ->capture_default_str();
+  model_form_.add_to(*app_);
   app_->add_flag("-q,--quiet", quiet_, "No progress bar");
 }
 
 int DiagnoseCommand::run() const {
   if (model_ != "msm" && model_ != "fem") throw UsageError("--model must be msm or fem");
+  host::DiagnoseOptions options;
+  options.model = model_;
+  const ModelFormChoice form = model_form_.apply(*app_);
+  if (model_ == "fem" && ModelFormOptions::given(*app_)) {
+    throw UsageError(
+        "--alpha, --msm-alpha, --steps-per-frame and --cluster-radius shape the msm baseline; "
+        "--model fem takes none of them");
+  }
+  options.alpha = form.alpha;
+  options.msm_alpha = form.msm_alpha;
+  options.steps_per_frame = form.steps_per_frame;
+  options.cluster_radius_auto = form.cluster_radius_auto;
+  options.cluster_radius_factor = form.cluster_radius_factor;
   const host::Recording recording = host::read_recording(recording_);
   for (const std::string& warning : recording.warnings) report_warning(warning);
   if (model_ == "fem" && (recording.dimension != 3 || !recording.mesh || recording.length_unit != "m")) {
@@ -42,8 +56,6 @@ int DiagnoseCommand::run() const {
   host::DiagnoseResult result;
   {
     ProgressBar bar("diagnosing", !quiet_);
-    host::DiagnoseOptions options;
-    options.model = model_;
     options.progress = [&bar](const std::string&, int done, int total) { bar.update(done, total); };
     result = host::diagnose_recording(recording, options);
   }

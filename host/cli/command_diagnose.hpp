@@ -6,6 +6,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "model_form_options.hpp"
+
 namespace pliant::cli {
 
 class DiagnoseCommand {
@@ -21,6 +23,7 @@ class DiagnoseCommand {
   std::string json_path_;
   std::string report_dir_;
   std::string model_ = "msm";
+  ModelFormOptions model_form_;  ///< the MSM baseline's msm_alpha and steps per frame
   bool quiet_ = false;
 };
 

@@ -6,6 +6,7 @@
 #include "atomic_write.hpp"
 #include "estimate_summary.hpp"
 #include "exit_status.hpp"
+#include "model_form_options.hpp"
 #include "progress_bar.hpp"
 #include "pliant/host/estimate.hpp"
 #include "pliant/host/recording.hpp"
@@ -31,17 +32,7 @@ EstimateCommand::EstimateCommand(CLI::App& parent) {
   app_->add_option("--mode", mode_, "'trajectory': simulate every frame; 'final': match the final equilibrium only")
       ->type_name("final|trajectory")
       ->capture_default_str();
-  auto* alpha_option =
-      app_->add_option("--alpha", alpha_,
-                       "msm_alpha: 'auto' (default) fits it with msm_beta when the recording determines it (BIC), "
-                       "'fit' (also a bare --alpha) always, 'fixed=A' holds it at A in (0, 1] (the old default A = 1)")
-          ->type_name("auto|fit|fixed=A")
-          ->expected(0, 1);
-  app_->add_option("--msm-alpha", msm_alpha_, "Same as --alpha fixed=A")->type_name("A")->excludes(alpha_option);
-  app_->add_option("--steps-per-frame", steps_per_frame_,
-                   "MSM steps per frame interval: 'auto' (default) chooses 1-4 with msm_alpha (BIC), or N in 1..64")
-      ->type_name("auto|N")
-      ->capture_default_str();
+  model_form_.add_to(*app_);
   app_->add_option("--grid", grid_points_, "Grid points over msm_beta in [0, 1] before refinement (>= 3)")
       ->type_name("N")
       ->capture_default_str();
@@ -55,30 +46,12 @@ int EstimateCommand::run() const {
   } catch (const std::invalid_argument& e) {
     throw UsageError(e.what());
   }
-  try {
-    host::parse_alpha_choice(alpha_, options.alpha, options.msm_alpha);
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(e.what());
-  }
-  if (app_->count("--msm-alpha") > 0) {
-    if (!(msm_alpha_ > 0.0 && msm_alpha_ <= 1.0)) throw UsageError("--msm-alpha must be in (0, 1]");
-    options.alpha = host::AlphaMode::fixed;
-    options.msm_alpha = msm_alpha_;
-  }
-  if (steps_per_frame_ != "auto") {
-    std::size_t used = 0;
-    int steps = 0;
-    try {
-      steps = std::stoi(steps_per_frame_, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != steps_per_frame_.size() || steps < 1 || steps > max_steps_per_frame) {
-      throw UsageError("--steps-per-frame must be 'auto' or a whole number in 1.." +
-                       std::to_string(max_steps_per_frame) + ", not '" + steps_per_frame_ + "'");
-    }
-    options.steps_per_frame = steps;
-  }
+  const ModelFormChoice form = model_form_.apply(*app_);
+  options.alpha = form.alpha;
+  options.msm_alpha = form.msm_alpha;
+  options.steps_per_frame = form.steps_per_frame;
+  options.cluster_radius_auto = form.cluster_radius_auto;
+  options.setup.clusters.radius_factor = form.cluster_radius_factor;
   if (options.alpha == host::AlphaMode::fitted && options.mode != FitMode::trajectory) {
     throw UsageError("--alpha fit needs --mode trajectory");
   }

@@ -5,6 +5,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "model_form_options.hpp"
+
 namespace pliant::cli {
 
 class EstimateCommand {
@@ -21,9 +23,7 @@ class EstimateCommand {
   std::string recording_;
   std::string json_path_;
   std::string mode_ = "trajectory";
-  std::string alpha_ = "auto";
-  std::string steps_per_frame_ = "auto";
-  double msm_alpha_ = 1.0;
+  ModelFormOptions model_form_;
   int grid_points_ = 11;
   bool quiet_ = false;
 };

@@ -38,6 +38,41 @@ TEST(cli_diagnose, ElasticRecordingIsConsistentAndTheJsonFollowsTheSpec) {
   EXPECT_TRUE(fs::exists(fs::path(report) / "index.html"));
 }
 
+// A press simulated with msm_alpha 0.5, two MSM steps per frame and clusters of radius 2: the
+// baseline takes that form (the options of old named a missing effect on such recordings),
+// says so under baseline.form, and the options pin it back.
+TEST(cli_diagnose, TheBaselineTakesTheRecordingsModelFormAndTheOptionsPinIt) {
+  TempDir dir;
+  const std::string recording = dir / "ring";
+  ASSERT_EQ(run_pliant("simulate ring_squeeze -o " + quoted(recording) +
+                       " --beta 0.6 --alpha 0.5 --substeps 2 --cluster-radius 2 --noise 0.005 --seed 4")
+                .status,
+            0);
+  const CommandResult automatic = run_pliant("diagnose " + quoted(recording) + " -q --json -");
+  ASSERT_EQ(automatic.status, 0) << automatic.err;
+  const nlohmann::json j = nlohmann::json::parse(automatic.out);
+  EXPECT_EQ(j.at("verdict"), "consistent") << j.at("explanation");
+  const nlohmann::json& form = j.at("baseline").at("form");
+  EXPECT_EQ(form.at("msm_alpha"), "fitted");
+  EXPECT_EQ(form.at("steps_per_frame"), 2);
+  EXPECT_DOUBLE_EQ(form.at("cluster_radius_factor").get<double>(), 2.0);
+  EXPECT_FALSE(form.at("reason").get<std::string>().empty());
+  EXPECT_NEAR(j.at("baseline").at("parameters").at("msm_beta").get<double>(), 0.6, 0.03);
+  EXPECT_NEAR(j.at("baseline").at("parameters").at("msm_alpha").get<double>(), 0.5, 0.05);
+
+  const CommandResult pinned = run_pliant("diagnose " + quoted(recording) +
+                                          " -q --json - --alpha fixed=1 --steps-per-frame 1 --cluster-radius 1.5");
+  ASSERT_EQ(pinned.status, 0) << pinned.err;
+  const nlohmann::json p = nlohmann::json::parse(pinned.out);
+  const nlohmann::json& held = p.at("baseline").at("form");
+  EXPECT_EQ(held.at("msm_alpha"), "held");
+  EXPECT_EQ(held.at("steps_per_frame"), 1);
+  EXPECT_DOUBLE_EQ(held.at("cluster_radius_factor").get<double>(), 1.5);
+  EXPECT_DOUBLE_EQ(p.at("baseline").at("parameters").at("msm_alpha").get<double>(), 1.0);
+  // Held at the wrong form, the baseline misfits the recording by far more.
+  EXPECT_GT(p.at("baseline").at("rms").get<double>(), 2.0 * j.at("baseline").at("rms").get<double>());
+}
+
 TEST(cli_diagnose, MalformedRecordingExitsTwoWithoutJson) {
   TempDir dir;
   const fs::path recording = dir.path() / "rec";

@@ -49,8 +49,15 @@ TEST(cli_usage, UnknownOptionIsOneLineAndExitsTwo) {
 TEST(cli_usage, CommandHelpShowsItsOptions) {
   const CommandResult estimate = run_pliant("estimate --help");
   EXPECT_EQ(estimate.status, 0);
-  for (const char* option : {"--json", "--mode", "--alpha", "--msm-alpha", "--steps-per-frame", "--grid", "--quiet"}) {
+  for (const char* option :
+       {"--json", "--mode", "--alpha", "--msm-alpha", "--steps-per-frame", "--cluster-radius", "--grid", "--quiet"}) {
     EXPECT_TRUE(contains(estimate.out, option)) << option;
+  }
+  const CommandResult diagnose = run_pliant("diagnose --help");
+  EXPECT_EQ(diagnose.status, 0);
+  for (const char* option : {"--json", "--report", "--model", "--alpha", "--msm-alpha", "--steps-per-frame",
+                             "--cluster-radius", "--quiet"}) {
+    EXPECT_TRUE(contains(diagnose.out, option)) << option;
   }
   const CommandResult simulate = run_pliant("simulate --help");
   EXPECT_EQ(simulate.status, 0);
@@ -94,6 +101,11 @@ TEST(cli_usage, BadEstimateOptionValuesExitTwoWithOneLine) {
       {"--steps-per-frame 2.5", "--steps-per-frame"},
       {"--steps-per-frame many", "--steps-per-frame"},
       {"--steps-per-frame -1", "--steps-per-frame"},
+      {"--cluster-radius 0.9", "--cluster-radius"},
+      {"--cluster-radius 4.5", "--cluster-radius"},
+      {"--cluster-radius nan", "--cluster-radius"},
+      {"--cluster-radius wide", "--cluster-radius"},
+      {"--cluster-radius 1.5x", "--cluster-radius"},
   };
   for (const BadOption& c : cases) {
     const CommandResult r = run_pliant("estimate " + quoted(dir / "rec") + " " + c.arguments);
@@ -102,6 +114,36 @@ TEST(cli_usage, BadEstimateOptionValuesExitTwoWithOneLine) {
     EXPECT_EQ(r.err.rfind("pliant estimate: ", 0), 0u) << r.err;
     EXPECT_TRUE(contains(r.err, c.mentions)) << c.arguments << ": " << r.err;
     EXPECT_EQ(r.out, "") << c.arguments;
+  }
+}
+
+// diagnose takes the same model-form options, with the same refusals, and refuses them with
+// the FEM baseline, which has no such form.
+TEST(cli_usage, BadDiagnoseModelFormOptionsExitTwoWithOneLine) {
+  TempDir dir;
+  write_tiny_recording(dir / "rec");
+  const std::vector<BadOption> cases = {
+      {"--msm-alpha 1.5", "--msm-alpha"},
+      {"--alpha --msm-alpha 0.5", "--alpha"},
+      {"--alpha sometimes", "--alpha"},
+      {"--alpha fixed=0", "--alpha"},
+      {"--steps-per-frame 65", "--steps-per-frame"},
+      {"--steps-per-frame many", "--steps-per-frame"},
+      {"--cluster-radius 0.9", "--cluster-radius"},
+      {"--cluster-radius wide", "--cluster-radius"},
+      {"--model fem --alpha fit", "--model fem"},
+      {"--model fem --cluster-radius 2", "--model fem"},
+  };
+  const std::string out = dir / "out.json";
+  for (const BadOption& c : cases) {
+    const CommandResult r =
+        run_pliant("diagnose " + quoted(dir / "rec") + " -q --json " + quoted(out) + " " + c.arguments);
+    EXPECT_EQ(r.status, 2) << c.arguments;
+    ASSERT_EQ(r.err_lines().size(), 1u) << c.arguments << ": " << r.err;
+    EXPECT_EQ(r.err.rfind("pliant diagnose: ", 0), 0u) << r.err;
+    EXPECT_TRUE(contains(r.err, c.mentions)) << c.arguments << ": " << r.err;
+    EXPECT_EQ(r.out, "") << c.arguments;
+    EXPECT_FALSE(fs::exists(out)) << c.arguments;
   }
 }
 

@@ -110,6 +110,22 @@ TEST(MsmModel, DrivenMassFactorScalesOnlyDrivableParticles) {
   EXPECT_DOUBLE_EQ(f.model.mass[12], 1.0);
 }
 
+TEST(MsmModel, AParticleJustBeyondTheRadiusJoinsItsNearestNeighbours) {
+  // A 4 x 3 lattice of spacing 1 (radius 1.5) and one particle 2 from the corner (0, 0): no
+  // neighbour within the radius, its nearest within twice it. Its cluster holds the particles
+  // within 1.5 x 2 = 3 of it; no other cluster holds it.
+  auto rest = lattice<2, double>(4, 3, 1, 1.0);
+  rest.push_back(-2.0);
+  rest.push_back(0.0);
+  pliant::test::MsmFixture<2, double> f(config_over<2>(rest));
+  ASSERT_EQ(f.status, Status::ok);
+  const int sparse = 12;
+  std::vector<int> members(f.model.members + f.model.cluster_begin[sparse],
+                           f.model.members + f.model.cluster_begin[sparse + 1]);
+  EXPECT_EQ(members, (std::vector<int>{0, 1, 4, 8, 12}));  // (0,0), (1,0), (0,1), (0,2) and itself
+  EXPECT_EQ(f.model.particle_cluster_begin[sparse + 1] - f.model.particle_cluster_begin[sparse], 1);
+}
+
 TEST(MsmModel, RejectsBadInputWithAStatus) {
   auto rest = lattice<2, double>(4, 3, 1, 1.0);
   {  // zero mass

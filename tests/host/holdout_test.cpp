@@ -68,5 +68,19 @@ TEST(ResidualRms, RejectsInconsistentSizes) {
   EXPECT_THROW(residual_rms(four, four, 1, 0, Mask{0, 0}, 0), std::invalid_argument);
 }
 
+// Misfit 5 over noise 1: an excess of 24 in mean square. A fit at 3 leaves 8 of it (two
+// thirds explained), one at the noise leaves none, one below the noise cannot do better than
+// all, one worse than the baseline is negative; a baseline within the noise has nothing to
+// explain.
+TEST(ExplainedShare, IsTheShareOfTheMeanSquareBeyondTheNoise) {
+  EXPECT_DOUBLE_EQ(explained_share(5.0, 3.0, 1.0), 1.0 - 8.0 / 24.0);
+  EXPECT_DOUBLE_EQ(explained_share(5.0, 1.0, 1.0), 1.0);
+  EXPECT_DOUBLE_EQ(explained_share(5.0, 0.5, 1.0), 1.0);
+  EXPECT_DOUBLE_EQ(explained_share(5.0, 5.0, 1.0), 0.0);
+  EXPECT_LT(explained_share(5.0, 6.0, 1.0), 0.0);
+  EXPECT_DOUBLE_EQ(explained_share(0.8, 0.5, 1.0), 0.0);
+  EXPECT_DOUBLE_EQ(explained_share(2.0, 1.0, 0.0), 0.75);  // no noise: the plain share of the mean square
+}
+
 }  // namespace
 }  // namespace pliant::host::test

@@ -6,6 +6,8 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <random>
 #include <sstream>
 #include <stdexcept>
 
@@ -16,6 +18,7 @@
 #include "pliant/host/diagnose/model_run.hpp"
 #include "pliant/host/diagnose/noise_floor.hpp"
 #include "pliant/host/diagnose/residual_field.hpp"
+#include "pliant/host/estimate.hpp"
 
 namespace pliant::host {
 namespace {
@@ -44,30 +47,15 @@ class Scorer {
 
   Score score(const std::vector<double>& simulated) const {
     Score s;
-    const int n = recording_.particle_count;
-    const int dim = recording_.dimension;
-    for (int k = 0; k < recording_.frame_count(); ++k) {
-      const bool held = held_out_[static_cast<std::size_t>(k)] != 0;
-      for (int i = 0; i < n; ++i) {
-        const std::size_t pair =
-            static_cast<std::size_t>(k) * static_cast<std::size_t>(n) + static_cast<std::size_t>(i);
-        if (pairs_[pair] == 0) continue;
-        double squared = 0;
-        for (int d = 0; d < dim; ++d) {
-          const double r = simulated[pair * static_cast<std::size_t>(dim) + static_cast<std::size_t>(d)] -
-                           recording_.position(k, i, d);
-          squared += r * r;
-        }
-        if (!std::isfinite(squared)) continue;
-        if (held) {
-          s.held_rss += squared;
-          ++s.held_pairs;
-        } else {
-          s.fit_rss += squared;
-          ++s.fit_pairs;
-        }
+    for_each_pair(simulated, [&](int frame, double squared) {
+      if (held_out_[static_cast<std::size_t>(frame)] != 0) {
+        s.held_rss += squared;
+        ++s.held_pairs;
+      } else {
+        s.fit_rss += squared;
+        ++s.fit_pairs;
       }
-    }
+    });
     return s;
   }
 
@@ -92,24 +80,99 @@ class Scorer {
     return Eigen::Map<Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
   }
 
+  /// The particle of every scalar fit_residuals returns, in the same order.
+  std::vector<int> fit_residual_particles() const {
+    std::vector<int> ids;
+    const int n = recording_.particle_count;
+    for (int k = 0; k < recording_.frame_count(); ++k) {
+      if (held_out_[static_cast<std::size_t>(k)] != 0) continue;
+      for (int i = 0; i < n; ++i) {
+        if (pairs_[static_cast<std::size_t>(k) * static_cast<std::size_t>(n) + static_cast<std::size_t>(i)] == 0)
+          continue;
+        ids.insert(ids.end(), static_cast<std::size_t>(recording_.dimension), i);
+      }
+    }
+    return ids;
+  }
+
+  /// Held-out residual sum of squares and compared pairs per held-out block (a run of
+  /// consecutive held-out frames), in frame order: what a block bootstrap of frames resamples.
+  std::vector<Score> held_blocks(const std::vector<double>& simulated) const {
+    // Block index of every held-out frame, counted in frame order.
+    std::vector<int> block_of(held_out_.size(), -1);
+    int blocks_seen = 0;
+    for (std::size_t k = 0; k < held_out_.size(); ++k) {
+      if (held_out_[k] == 0) continue;
+      if (k == 0 || held_out_[k - 1] == 0) ++blocks_seen;
+      block_of[k] = blocks_seen - 1;
+    }
+    std::vector<Score> blocks(static_cast<std::size_t>(blocks_seen));
+    for_each_pair(simulated, [&](int frame, double squared) {
+      const int block = block_of[static_cast<std::size_t>(frame)];
+      if (block < 0) return;
+      blocks[static_cast<std::size_t>(block)].held_rss += squared;
+      ++blocks[static_cast<std::size_t>(block)].held_pairs;
+    });
+    return blocks;
+  }
+
   const std::vector<unsigned char>& held_out() const { return held_out_; }
 
  private:
+  // Calls visit(frame, squared Euclidean residual) for every compared pair with a finite one.
+  template <typename Visit>
+  void for_each_pair(const std::vector<double>& simulated, Visit&& visit) const {
+    const int n = recording_.particle_count;
+    const int dim = recording_.dimension;
+    for (int k = 0; k < recording_.frame_count(); ++k) {
+      for (int i = 0; i < n; ++i) {
+        const std::size_t pair =
+            static_cast<std::size_t>(k) * static_cast<std::size_t>(n) + static_cast<std::size_t>(i);
+        if (pairs_[pair] == 0) continue;
+        double squared = 0;
+        for (int d = 0; d < dim; ++d) {
+          const double r = simulated[pair * static_cast<std::size_t>(dim) + static_cast<std::size_t>(d)] -
+                           recording_.position(k, i, d);
+          squared += r * r;
+        }
+        if (std::isfinite(squared)) visit(k, squared);
+      }
+    }
+  }
+
   const Recording& recording_;
   std::vector<unsigned char> pairs_;
   std::vector<unsigned char> held_out_;
 };
 
+// The parts of the baseline's model form that are not physics: chosen once (estimate's
+// selection) and kept for every candidate. msm_alpha is then either held or refitted with each.
+struct ModelForm {
+  int steps_per_frame = 1;
+  bool fit_alpha = false;
+  double alpha = 1.0;  // held value, or the baseline's fitted one (the start of every fit)
+  double cluster_radius_factor = MsmSetupOptions{}.clusters.radius_factor;
+};
+
 struct Fit {
-  std::vector<double> u;       // search coordinates: [0] msm_beta, then the effect's
+  ModelForm form;              // the model form the fit was made in
+  std::vector<double> u;       // search coordinates: msm_beta, msm_alpha when fitted, then the effect's
   std::vector<double> values;  // physical effect parameter values
   std::vector<double> std;     // one std per effect parameter (inf when not identifiable)
   double beta = 0;
   double beta_std = 0;
+  double alpha = 1;
+  double alpha_std = std::numeric_limits<double>::infinity();  // inf when held
   Score score;
   std::vector<double> simulated;
-  double bic = 0;
+  Eigen::VectorXd fit_residuals;  // fitting-frame residual scalars, Scorer::fit_residuals order
+  int fitted = 0;                 // coordinates fitted
 };
+
+// msm_alpha's search coordinate: [0, 1] onto the range the estimator searches.
+constexpr double kAlphaLow = 0.05;
+double alpha_of(double u) { return kAlphaLow + (1.0 - kAlphaLow) * std::clamp(u, 0.0, 1.0); }
+double alpha_coordinate(double alpha) { return std::clamp((alpha - kAlphaLow) / (1.0 - kAlphaLow), 0.0, 1.0); }
 
 // Golden-section search of f on [lo, hi] to `tolerance`, starting from a known best point.
 template <typename F>
@@ -189,53 +252,105 @@ PatchSplit split_patches(const std::vector<std::vector<int>>& patches, const std
 
 class Fitter {
  public:
-  Fitter(const RecordingSimulator& simulator, const Scorer& scorer, const EffectContext& context)
-      : simulator_(simulator), scorer_(scorer), context_(context) {}
+  Fitter(const RecordingSimulator& simulator, const Scorer& scorer, const EffectContext& context, ModelForm form)
+      : simulator_(simulator), scorer_(scorer), context_(context), form_(form) {}
 
-  ModelSettings settings(const Effect* effect, double beta, const std::vector<double>& values) const {
-    ModelSettings s;
-    s.msm_beta = std::clamp(beta, 0.0, 1.0);
-    if (effect != nullptr) effect->apply(values, context_, s);
-    return s;
+  const ModelForm& form() const { return form_; }
+
+  // Index of the effect's first coordinate in u: after msm_beta and, when fitted, msm_alpha.
+  std::size_t effect_offset() const { return form_.fit_alpha ? 2 : 1; }
+
+  // Search coordinates of the baseline at msm_beta `beta` and msm_alpha `alpha`.
+  std::vector<double> baseline_coordinates(double beta, double alpha) const {
+    std::vector<double> u{beta};
+    if (form_.fit_alpha) u.push_back(alpha_coordinate(alpha));
+    return u;
   }
+
+  double alpha(const std::vector<double>& u) const { return form_.fit_alpha ? alpha_of(u[1]) : form_.alpha; }
 
   std::vector<double> physical(const Effect* effect, const std::vector<double>& u) const {
     std::vector<double> values;
     if (effect == nullptr) return values;
-    for (std::size_t p = 0; p < effect->parameters.size(); ++p) values.push_back(effect->parameters[p].value(u[p + 1]));
+    for (std::size_t p = 0; p < effect->parameters.size(); ++p)
+      values.push_back(effect->parameters[p].value(u[effect_offset() + p]));
     return values;
   }
 
-  double objective(const Effect* effect, const std::vector<double>& u) {
+  ModelSettings settings(const Effect* effect, const std::vector<double>& u) const {
+    ModelSettings s;
+    s.msm_beta = std::clamp(u[0], 0.0, 1.0);
+    s.msm_alpha = alpha(u);
+    s.steps_per_frame = form_.steps_per_frame;
+    if (effect != nullptr) effect->apply(physical(effect, u), context_, s);
+    return s;
+  }
+
+  std::vector<double> simulate(const Effect* effect, const std::vector<double>& u) {
     ++evaluations;
-    const std::vector<double> sim = simulator_.simulate(settings(effect, u[0], physical(effect, u)));
-    return scorer_.score(sim).fit_rss;
+    return simulator_.simulate(settings(effect, u));
+  }
+
+  double objective(const Effect* effect, const std::vector<double>& u) {
+    return scorer_.score(simulate(effect, u)).fit_rss;
   }
 
   // Fitting-frame residuals at search coordinates u (one simulation).
   Eigen::VectorXd residuals(const Effect* effect, const std::vector<double>& u) {
-    ++evaluations;
-    return scorer_.fit_residuals(simulator_.simulate(settings(effect, u[0], physical(effect, u))));
+    return scorer_.fit_residuals(simulate(effect, u));
   }
 
-  // The fit: a grid over the effect's scanned coordinates (responses flat near the null need
+  // Coordinates a fit moves: msm_beta unless the effect sets it per patch, msm_alpha when the
+  // model form fits it, and every effect parameter.
+  std::vector<int> free_coordinates(const Effect* effect, std::size_t size) const {
+    std::vector<int> free;
+    if (effect == nullptr || !effect->replaces_beta) free.push_back(0);
+    for (std::size_t c = 1; c < size; ++c) free.push_back(static_cast<int>(c));
+    return free;
+  }
+
+  // The baseline: msm_beta by a grid and golden section at the form's msm_alpha, then, when the
+  // form fits msm_alpha, both together by Levenberg-Marquardt.
+  Fit fit_baseline() {
+    const std::vector<double> start = baseline_coordinates(0.5, form_.alpha);
+    auto at_beta = [&](double beta) {
+      std::vector<double> u = start;
+      u[0] = beta;
+      return objective(nullptr, u);
+    };
+    double best_beta = 0.5;
+    double best_rss = std::numeric_limits<double>::infinity();
+    for (int i = 0; i <= 10; ++i) {
+      const double rss = at_beta(i / 10.0);
+      if (rss < best_rss) {
+        best_rss = rss;
+        best_beta = i / 10.0;
+      }
+    }
+    golden(at_beta, std::max(0.0, best_beta - 0.1), std::min(1.0, best_beta + 0.1), 1e-3, best_beta, best_rss);
+    std::vector<double> u = start;
+    u[0] = best_beta;
+    if (form_.fit_alpha) levenberg_marquardt(nullptr, u);
+    return finish(nullptr, u);
+  }
+
+  // An effect's fit: a grid over its scanned coordinates (responses flat near the null need
   // it), msm_beta profiled out at every grid point by Gauss-Newton (it trades off against
-  // most effects), then bounded Levenberg-Marquardt on all coordinates from the two best grid
-  // points.
-  Fit fit(const Effect* effect, double start_beta) {
-    std::vector<double> start(1, start_beta);
-    std::vector<int> scanned;
+  // most effects), then bounded Levenberg-Marquardt on every free coordinate from the two best
+  // grid points. `baseline` gives the start of msm_beta and msm_alpha.
+  Fit fit(const Effect* effect, const Fit& baseline) {
+    std::vector<double> start(baseline.u.begin(), baseline.u.begin() + static_cast<long>(effect_offset()));
+    std::vector<std::size_t> scanned;
     for (std::size_t p = 0; p < effect->parameters.size(); ++p) {
       const EffectParameter& parameter = effect->parameters[p];
       double u = 0.0;
       if (std::isfinite(parameter.null_value))
         u = parameter.coordinate(parameter.null_value);
       else if (effect->replaces_beta)
-        u = parameter.coordinate(start_beta);
+        u = parameter.coordinate(baseline.beta);
       start.push_back(u);
-      if (parameter.scanned) scanned.push_back(static_cast<int>(p) + 1);
+      if (parameter.scanned) scanned.push_back(effect_offset() + p);
     }
-    const bool fit_beta = !effect->replaces_beta;
 
     struct Seed {
       std::vector<double> u;
@@ -245,15 +360,26 @@ class Fitter {
     const int per_axis = scanned.size() <= 1 ? 7 : (scanned.size() == 2 ? 5 : 4);
     long points = 1;
     for (std::size_t a = 0; a < scanned.size(); ++a) points *= per_axis;
-    for (long index = 0; index < points; ++index) {
-      std::vector<double> u = start;
-      long rest = index;
-      for (int c : scanned) {
-        u[static_cast<std::size_t>(c)] = static_cast<double>(rest % per_axis) / (per_axis - 1);
-        rest /= per_axis;
+    // With msm_alpha fitted, the grid also starts from msm_alpha = 1: the baseline's msm_alpha
+    // may have absorbed part of the effect (a lagging model mimics creep), and from there the
+    // effect's own basin can be out of reach.
+    std::vector<double> alpha_starts;
+    if (form_.fit_alpha) {
+      alpha_starts.push_back(start[1]);
+      if (start[1] < alpha_coordinate(0.95)) alpha_starts.push_back(1.0);
+    }
+    for (std::size_t a = 0; a < std::max<std::size_t>(alpha_starts.size(), 1); ++a) {
+      if (form_.fit_alpha) start[1] = alpha_starts[a];
+      for (long index = 0; index < points; ++index) {
+        std::vector<double> u = start;
+        long rest = index;
+        for (std::size_t c : scanned) {
+          u[c] = static_cast<double>(rest % per_axis) / (per_axis - 1);
+          rest /= per_axis;
+        }
+        const double cost = effect->replaces_beta ? residuals(effect, u).squaredNorm() : profile_beta(effect, u);
+        seeds.push_back({u, cost});
       }
-      const double cost = fit_beta ? profile_beta(effect, u) : residuals(effect, u).squaredNorm();
-      seeds.push_back({u, cost});
     }
     std::sort(seeds.begin(), seeds.end(), [](const Seed& a, const Seed& b) { return a.cost < b.cost; });
     std::vector<double> best_u = seeds.front().u;
@@ -261,7 +387,7 @@ class Fitter {
     const std::size_t starts = std::min<std::size_t>(seeds.size(), 2);
     for (std::size_t k = 0; k < starts; ++k) {
       std::vector<double> u = seeds[k].u;
-      const double cost = levenberg_marquardt(effect, u, fit_beta);
+      const double cost = levenberg_marquardt(effect, u);
       if (cost < best_cost) {
         best_cost = cost;
         best_u = u;
@@ -297,14 +423,15 @@ class Fitter {
   // Bounded Levenberg-Marquardt in the unit coordinates: forward-difference Jacobian, bounds by
   // projection, coordinates held at a bound while the gradient pushes outward. Returns the
   // fitting-frame residual sum of squares at the final u.
-  double levenberg_marquardt(const Effect* effect, std::vector<double>& u, bool fit_beta) {
+  double levenberg_marquardt(const Effect* effect, std::vector<double>& u) {
+    const std::vector<int> coordinates = free_coordinates(effect, u.size());
     const int p = static_cast<int>(u.size());
     Eigen::VectorXd r = residuals(effect, u);
     double cost = r.squaredNorm();
     double lambda = 1e-2;
     for (int iteration = 0; iteration < 25; ++iteration) {
       Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(r.size(), p);
-      for (int c = fit_beta ? 0 : 1; c < p; ++c) {
+      for (int c : coordinates) {
         const double h = u[static_cast<std::size_t>(c)] + 0.005 <= 1.0 ? 0.005 : -0.005;
         std::vector<double> probe = u;
         probe[static_cast<std::size_t>(c)] += h;
@@ -312,7 +439,7 @@ class Fitter {
       }
       const Eigen::VectorXd gradient = jacobian.transpose() * r;
       std::vector<int> free;
-      for (int c = fit_beta ? 0 : 1; c < p; ++c) {
+      for (int c : coordinates) {
         const double uc = u[static_cast<std::size_t>(c)];
         const double gc = gradient(c);
         if ((uc <= 0.0 && gc > 0) || (uc >= 1.0 && gc < 0)) continue;
@@ -361,36 +488,37 @@ class Fitter {
     return cost;
   }
 
+  // The fit at u with its scores and the std of every fitted parameter.
   Fit finish(const Effect* effect, const std::vector<double>& u) {
     Fit f;
+    f.form = form_;
     f.u = u;
     f.beta = u[0];
+    f.alpha = alpha(u);
     f.values = physical(effect, u);
-    f.simulated = simulator_.simulate(settings(effect, f.beta, f.values));
+    f.simulated = simulate(effect, u);
     f.score = scorer_.score(f.simulated);
-    // Uncertainty: J = d residual / d parameter by central differences; cov = s^2 (J^T J)^-1.
-    const Eigen::VectorXd r0 = scorer_.fit_residuals(f.simulated);
+    f.fit_residuals = scorer_.fit_residuals(f.simulated);
+    // Uncertainty: J = d residual / d parameter by central differences; cov = s^2 (J^T J)^-1,
+    // before the design effect (rank_fits widens it).
+    const std::vector<int> coordinates = free_coordinates(effect, u.size());
+    const Eigen::VectorXd& r0 = f.fit_residuals;
     const int p = static_cast<int>(u.size());
-    const int first = effect != nullptr && effect->replaces_beta ? 1 : 0;
     Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(r0.size(), p);
-    for (int c = first; c < p; ++c) {
+    for (int c : coordinates) {
       const double h = 0.01;
       std::vector<double> up = u;
       std::vector<double> down = u;
       up[static_cast<std::size_t>(c)] = std::min(1.0, u[static_cast<std::size_t>(c)] + h);
       down[static_cast<std::size_t>(c)] = std::max(0.0, u[static_cast<std::size_t>(c)] - h);
-      const std::vector<double> vu = physical(effect, up);
-      const std::vector<double> vd = physical(effect, down);
-      const double step =
-          c == 0 ? up[0] - down[0] : vu[static_cast<std::size_t>(c - 1)] - vd[static_cast<std::size_t>(c - 1)];
-      evaluations += 2;
-      const Eigen::VectorXd ru = scorer_.fit_residuals(simulator_.simulate(settings(effect, up[0], vu)));
-      const Eigen::VectorXd rd = scorer_.fit_residuals(simulator_.simulate(settings(effect, down[0], vd)));
+      const double step = physical_value(effect, up, c) - physical_value(effect, down, c);
+      const Eigen::VectorXd ru = residuals(effect, up);
+      const Eigen::VectorXd rd = residuals(effect, down);
       jacobian.col(c) = std::abs(step) > 0 ? Eigen::VectorXd((ru - rd) / step) : Eigen::VectorXd::Zero(r0.size());
     }
-    const int fitted = p - first;
+    f.fitted = static_cast<int>(coordinates.size());
     const double n = static_cast<double>(r0.size());
-    const double s2 = n > fitted ? r0.squaredNorm() / (n - fitted) : 0.0;
+    const double s2 = n > f.fitted ? r0.squaredNorm() / (n - f.fitted) : 0.0;
     const Eigen::MatrixXd normal = jacobian.transpose() * jacobian;
     Eigen::JacobiSVD<Eigen::MatrixXd> svd(normal, Eigen::ComputeFullU | Eigen::ComputeFullV);
     const Eigen::VectorXd sigma = svd.singularValues();
@@ -408,22 +536,30 @@ class Fitter {
       return identified && v >= 0 ? std::sqrt(v) : std::numeric_limits<double>::infinity();
     };
     f.beta_std = std_of(0);
-    for (int c = 1; c < p; ++c) f.std.push_back(std_of(c));
-    if (first == 1) {
+    if (form_.fit_alpha) f.alpha_std = std_of(1);
+    for (int c = static_cast<int>(effect_offset()); c < p; ++c) f.std.push_back(std_of(c));
+    if (effect != nullptr && effect->replaces_beta) {
       // Per-patch stiffness: msm_beta is the bulk's (the larger group of patches by msm_beta).
       f.beta = split_patches(context_.patches, f.values).bulk_beta;
       f.beta_std = std::numeric_limits<double>::infinity();
     }
-    f.bic = n > 0 && f.score.fit_rss > 0 ? n * std::log(f.score.fit_rss / n) + fitted * std::log(n) : 0.0;
     return f;
   }
 
   int evaluations = 0;
 
  private:
+  // Coordinate c of u in physical units: msm_beta, msm_alpha, or the effect parameter.
+  double physical_value(const Effect* effect, const std::vector<double>& u, int c) const {
+    if (c == 0) return u[0];
+    if (form_.fit_alpha && c == 1) return alpha(u);
+    return effect->parameters[static_cast<std::size_t>(c) - effect_offset()].value(u[static_cast<std::size_t>(c)]);
+  }
+
   const RecordingSimulator& simulator_;
   const Scorer& scorer_;
   const EffectContext& context_;
+  ModelForm form_;
 };
 
 std::string id_list(const std::vector<int>& ids) {
@@ -465,6 +601,207 @@ std::vector<double> magnitudes(const Recording& recording, const std::vector<dou
       make_residual_field(recording.positions, simulated, recording.particle_count, recording.dimension));
 }
 
+// The model form of the baseline a user would fit: estimate's selection of msm_alpha (held or
+// fitted) and of the steps per frame (docs/estimation.md), made on the whole recording. Both
+// held by the options: no selection.
+struct FormChoice {
+  ModelForm form;
+  std::string reason;
+};
+
+FormChoice choose_model_form(const Recording& recording, const DiagnoseOptions& options) {
+  FormChoice choice;
+  if (options.alpha == AlphaMode::fixed && options.steps_per_frame > 0 && !options.cluster_radius_auto) {
+    choice.form.steps_per_frame = options.steps_per_frame;
+    choice.form.alpha = options.msm_alpha;
+    choice.form.cluster_radius_factor = options.cluster_radius_factor;
+    choice.reason = "msm_alpha, the steps per frame and the cluster radius were held as asked.";
+    return choice;
+  }
+  EstimateOptions estimate;
+  estimate.alpha = options.alpha;
+  estimate.msm_alpha = options.msm_alpha;
+  estimate.steps_per_frame = options.steps_per_frame;
+  estimate.cluster_radius_auto = options.cluster_radius_auto;
+  estimate.setup.clusters.radius_factor = options.cluster_radius_factor;
+  estimate.input_noise_samples = 0;
+  const BaselineChoice selection = estimate_recording(recording, estimate).baseline;
+  choice.form.steps_per_frame = selection.steps_per_frame();
+  choice.form.fit_alpha = selection.alpha_fitted();
+  choice.form.alpha = selection.candidates.empty()
+                          ? options.msm_alpha
+                          : selection.candidates[static_cast<std::size_t>(selection.chosen)].msm_alpha;
+  choice.form.cluster_radius_factor = selection.cluster_radius_factor(estimate.setup.clusters.radius_factor);
+  choice.reason = selection.reason;
+  return choice;
+}
+
+// Design effect (Kish 1965) of residuals clustered by particle: 1 + (m - 1) icc, m the residual
+// vectors per particle and icc the share of their variance that persists per particle over the
+// recording. Residuals correlated in time are worth fewer independent samples (n / deff).
+double design_effect(const Eigen::VectorXd& residuals, const std::vector<int>& particles, int particle_count,
+                     int dimension) {
+  std::vector<double> sums(static_cast<std::size_t>(particle_count) * static_cast<std::size_t>(dimension), 0.0);
+  std::vector<long> counts(static_cast<std::size_t>(particle_count), 0);
+  for (Eigen::Index j = 0; j < residuals.size(); ++j) {
+    const auto id = static_cast<std::size_t>(particles[static_cast<std::size_t>(j)]);
+    sums[id * static_cast<std::size_t>(dimension) + static_cast<std::size_t>(j % dimension)] += residuals(j);
+    if (j % dimension == 0) ++counts[id];
+  }
+  double between = 0;
+  long used = 0;
+  for (std::size_t id = 0; id < counts.size(); ++id) {
+    if (counts[id] == 0) continue;
+    ++used;
+    for (int d = 0; d < dimension; ++d) {
+      const double sum = sums[id * static_cast<std::size_t>(dimension) + static_cast<std::size_t>(d)];
+      between += sum * sum / static_cast<double>(counts[id]);
+    }
+  }
+  const double total = residuals.squaredNorm();
+  if (used == 0 || !(total > 0)) return 1.0;
+  const double per_particle = static_cast<double>(residuals.size()) / dimension / static_cast<double>(used);
+  if (!(per_particle > 1.0)) return 1.0;
+  const double icc = std::clamp((between / total - 1.0 / per_particle) / (1.0 - 1.0 / per_particle), 0.0, 1.0);
+  return 1.0 + (per_particle - 1.0) * icc;
+}
+
+// Bayesian information criterion of a fit over n residual scalars worth n_eff independent ones.
+double information_criterion(const Fit& fit, double n, double n_eff) {
+  const double rss = fit.fit_residuals.squaredNorm();
+  return n > 0 && rss > 0 ? n_eff * std::log(rss / n) + fit.fitted * std::log(n_eff) : 0.0;
+}
+
+struct Ranked {
+  std::size_t index = 0;  // into the effects
+  double significance = 0;
+  double improvement = 0;
+  double explained = 0;  // share of the misfit beyond noise explained (min_explained_share)
+  double bic = 0;
+  bool clear = false;   // passes every test but min_explained_share
+  bool passes = false;  // passes every test
+};
+
+// How stable the choice is under a block bootstrap of the held-out frames: resamples of the
+// held-out blocks (with replacement, fixed seed), each re-scoring the fits already made.
+struct Stability {
+  double explains = 0;     // share of resamples in which the chosen effect still improves enough
+  double wins = 0;         // ... and has the lowest held-out rms of the passing candidates
+  std::size_t rival = 0;   // the passing candidate that most often wins instead (== chosen: none)
+  double rival_share = 0;  // its share of wins
+};
+
+constexpr int kBootstrapResamples = 400;
+constexpr double kStableShare = 0.8;  // the named effect must hold in 80 % of resamples
+constexpr double kRivalShare = 0.2;   // a rival winning 20 % of them is reported
+
+Stability selection_stability(const Scorer& scorer, const Fit& baseline, const std::vector<Fit>& fits,
+                              const std::vector<Ranked>& ranked) {
+  const std::vector<Score> base_blocks = scorer.held_blocks(baseline.simulated);
+  std::vector<std::size_t> passing;
+  std::vector<std::vector<Score>> blocks;
+  for (const Ranked& r : ranked) {
+    if (!r.passes) continue;
+    passing.push_back(r.index);
+    blocks.push_back(scorer.held_blocks(fits[r.index].simulated));
+  }
+  Stability out;
+  out.rival = passing.front();
+  if (base_blocks.empty()) return out;
+  std::mt19937_64 random(0x5eed);
+  std::uniform_int_distribution<std::size_t> pick(0, base_blocks.size() - 1);
+  std::vector<int> win_count(passing.size(), 0);
+  int explains = 0;
+  std::vector<std::size_t> sample(base_blocks.size());
+  for (int b = 0; b < kBootstrapResamples; ++b) {
+    for (std::size_t& s : sample) s = pick(random);
+    auto rms_of = [&](const std::vector<Score>& per_block) {
+      double rss = 0;
+      long pairs = 0;
+      for (std::size_t s : sample) {
+        rss += per_block[s].held_rss;
+        pairs += per_block[s].held_pairs;
+      }
+      return pairs > 0 ? std::sqrt(rss / static_cast<double>(pairs)) : 0.0;
+    };
+    const double base = rms_of(base_blocks);
+    std::size_t winner = 0;
+    double winner_rms = std::numeric_limits<double>::infinity();
+    for (std::size_t c = 0; c < passing.size(); ++c) {
+      const double rms = rms_of(blocks[c]);
+      if (c == 0 && base > 0 && 1.0 - rms / base >= kMinImprovement) ++explains;
+      if (rms < winner_rms) {
+        winner_rms = rms;
+        winner = c;
+      }
+    }
+    ++win_count[winner];
+  }
+  out.explains = static_cast<double>(explains) / kBootstrapResamples;
+  out.wins = static_cast<double>(win_count[0]) / kBootstrapResamples;
+  for (std::size_t c = 1; c < passing.size(); ++c) {
+    const double share = static_cast<double>(win_count[c]) / kBootstrapResamples;
+    if (share > out.rival_share) {
+      out.rival_share = share;
+      out.rival = passing[c];
+    }
+  }
+  return out;
+}
+
+// Largest displacement of an observed particle from its first observed position.
+double largest_travel(const Recording& recording) {
+  double travel = 0;
+  for (int k = 0; k < recording.frame_count(); ++k) {
+    for (int i = 0; i < recording.particle_count; ++i) {
+      if (!recording.observed(k, i) || !recording.observed(0, i)) continue;
+      double squared = 0;
+      for (int d = 0; d < recording.dimension; ++d) {
+        const double step = recording.position(k, i, d) - recording.position(0, i, d);
+        squared += step * step;
+      }
+      travel = std::max(travel, std::sqrt(squared));
+    }
+  }
+  return travel;
+}
+
+// Size of the object (largest extent of the rest shape over the axes) and whether it stands on
+// a support line or plane.
+void describe_object(const RecordingSimulator& simulator, int n, int dim, EffectContext& context) {
+  const std::vector<double>& rest = simulator.rest();
+  double size = 0;
+  for (int d = 0; d < dim; ++d) {
+    double lo = std::numeric_limits<double>::infinity();
+    double hi = -lo;
+    for (int i = 0; i < n; ++i) {
+      lo = std::min(lo, rest[static_cast<std::size_t>(i * dim + d)]);
+      hi = std::max(hi, rest[static_cast<std::size_t>(i * dim + d)]);
+    }
+    size = std::max(size, hi - lo);
+  }
+  context.object_size = size > 0 ? size : 1.0;
+  double normal_length = 0;
+  for (double v : simulator.support_normal()) normal_length += v * v;
+  context.has_support = normal_length > 0.5;
+}
+
+// The MSM model as diagnosis-v1 writes it: msm_beta, msm_alpha (with its std when fitted) and
+// the model form.
+FittedModel msm_model(const Fit& fit, const ModelForm& form, const std::string& reason) {
+  FittedModel model;
+  model.model = "msm";
+  model.parameters = {{"msm_alpha", fit.alpha}, {"msm_beta", fit.beta}};
+  model.parameter_std = {{"msm_beta", fit.beta_std}};
+  if (form.fit_alpha) model.parameter_std["msm_alpha"] = fit.alpha_std;
+  model.rms = fit.score.held_rms();
+  model.steps_per_frame = form.steps_per_frame;
+  model.cluster_radius_factor = form.cluster_radius_factor;
+  model.alpha_fitted = form.fit_alpha;
+  model.form_reason = reason;
+  return model;
+}
+
 }  // namespace
 
 DiagnoseResult diagnose_recording(const Recording& recording, const DiagnoseOptions& options) {
@@ -497,72 +834,28 @@ DiagnoseResult diagnose_recording(const Recording& recording, const DiagnoseOpti
 
   const double noise_std = estimate_noise_std(recording);
   const double noise_rms = noise_std * std::sqrt(static_cast<double>(dim));
-
-  // Does anything move? Largest displacement of an observed particle from its first position.
-  double travel = 0;
-  for (int k = 0; k < frames; ++k) {
-    for (int i = 0; i < n; ++i) {
-      if (!recording.observed(k, i) || !recording.observed(0, i)) continue;
-      double squared = 0;
-      for (int d = 0; d < dim; ++d) {
-        const double step = recording.position(k, i, d) - recording.position(0, i, d);
-        squared += step * step;
-      }
-      travel = std::max(travel, std::sqrt(squared));
-    }
-  }
-  if (!(travel > 5.0 * std::max(noise_rms, 1e-12))) {
+  if (!(largest_travel(recording) > 5.0 * std::max(noise_rms, 1e-12))) {
     throw std::runtime_error("nothing moves beyond the measurement noise; there is no deformation to diagnose");
   }
 
   report("baseline", 0, 1);
-  const RecordingSimulator simulator(recording);
+  const FormChoice form = choose_model_form(recording, options);
+  MsmSetupOptions setup;
+  setup.clusters.radius_factor = form.form.cluster_radius_factor;
+  const RecordingSimulator simulator(recording, setup);
   EffectContext context;
   context.dimension = dim;
   context.particle_count = n;
-  {
-    const std::vector<double>& rest = simulator.rest();
-    double size = 0;
-    for (int d = 0; d < dim; ++d) {
-      double lo = std::numeric_limits<double>::infinity();
-      double hi = -lo;
-      for (int i = 0; i < n; ++i) {
-        lo = std::min(lo, rest[static_cast<std::size_t>(i * dim + d)]);
-        hi = std::max(hi, rest[static_cast<std::size_t>(i * dim + d)]);
-      }
-      size = std::max(size, hi - lo);
-    }
-    context.object_size = size > 0 ? size : 1.0;
-    double normal_length = 0;
-    for (double v : simulator.support_normal()) normal_length += v * v;
-    context.has_support = normal_length > 0.5;
-  }
-  Fitter fitter(simulator, scorer, context);
-
-  // Baseline: msm_beta by a grid and golden section on the fitting frames.
-  double best_beta = 0.5;
-  double best_rss = std::numeric_limits<double>::infinity();
-  for (int i = 0; i <= 10; ++i) {
-    const double beta = i / 10.0;
-    const double rss = fitter.objective(nullptr, {beta});
-    if (rss < best_rss) {
-      best_rss = rss;
-      best_beta = beta;
-    }
-  }
-  golden([&](double beta) { return fitter.objective(nullptr, {beta}); }, std::max(0.0, best_beta - 0.1),
-         std::min(1.0, best_beta + 0.1), 1e-3, best_beta, best_rss);
-  const Fit baseline = fitter.finish(nullptr, {best_beta});
+  describe_object(simulator, n, dim, context);
+  Fitter fitter(simulator, scorer, context, form.form);
+  const Fit baseline = fitter.fit_baseline();
   report("baseline", 1, 1);
 
   DiagnoseResult result;
   Diagnosis& out = result.diagnosis;
   out.recording = recording.name;
   out.noise_rms = noise_rms;
-  out.baseline.model = "msm";
-  out.baseline.parameters = {{"msm_alpha", 1.0}, {"msm_beta", baseline.beta}};
-  out.baseline.parameter_std = {{"msm_beta", baseline.beta_std}};
-  out.baseline.rms = baseline.score.held_rms();
+  out.baseline = msm_model(baseline, form.form, form.reason);
 
   // Locate.
   const ResidualField field = make_residual_field(recording.positions, baseline.simulated, n, dim);
@@ -576,34 +869,69 @@ DiagnoseResult diagnose_recording(const Recording& recording, const DiagnoseOpti
   // Candidates.
   const double misfit = noise_rms > 0 ? out.baseline.rms / noise_rms : std::numeric_limits<double>::infinity();
   const std::vector<Effect> effects = effect_catalogue(context);
+  // When the selection moved the form away from the plain one (msm_alpha 1, one step per frame,
+  // the setup's radius), every effect is also fitted in the plain form and the better fit kept:
+  // msm_alpha, steps or radius chosen without the effect may have absorbed part of it.
+  ModelForm plain;
+  plain.cluster_radius_factor = options.cluster_radius_factor;
+  const bool refit_plain = options.alpha == AlphaMode::automatic && options.steps_per_frame == 0 &&
+                           options.cluster_radius_auto &&
+                           (form.form.fit_alpha || form.form.steps_per_frame != 1 ||
+                            form.form.cluster_radius_factor != plain.cluster_radius_factor);
+  std::unique_ptr<RecordingSimulator> plain_simulator;
+  std::unique_ptr<Fitter> plain_fitter;
+  Fit plain_baseline;
+  if (refit_plain) {
+    MsmSetupOptions plain_setup;
+    plain_setup.clusters.radius_factor = plain.cluster_radius_factor;
+    plain_simulator = std::make_unique<RecordingSimulator>(recording, plain_setup);
+    plain_fitter = std::make_unique<Fitter>(*plain_simulator, scorer, context, plain);
+    plain_baseline = plain_fitter->fit_baseline();
+  }
   std::vector<Fit> fits;
   for (std::size_t e = 0; e < effects.size(); ++e) {
     report("effects", static_cast<int>(e), static_cast<int>(effects.size()));
-    fits.push_back(fitter.fit(&effects[e], baseline.beta));
+    fits.push_back(fitter.fit(&effects[e], baseline));
+    if (!refit_plain) continue;
+    Fit in_plain_form = plain_fitter->fit(&effects[e], plain_baseline);
+    if (in_plain_form.fit_residuals.squaredNorm() < fits.back().fit_residuals.squaredNorm()) {
+      fits.back() = std::move(in_plain_form);
+    }
   }
   report("effects", static_cast<int>(effects.size()), static_cast<int>(effects.size()));
 
-  struct Ranked {
-    std::size_t index;
-    double significance;
-    bool passes;
-  };
+  // Every score counts the residuals as worth n / deff independent samples, deff the design
+  // effect of the best-fitting model's residuals (the same for all, so that the scores compare).
+  const Fit* best_fit = &baseline;
+  for (const Fit& f : fits) {
+    if (f.fit_residuals.squaredNorm() < best_fit->fit_residuals.squaredNorm()) best_fit = &f;
+  }
+  const double deff = design_effect(best_fit->fit_residuals, scorer.fit_residual_particles(), n, dim);
+  const double residual_count = static_cast<double>(baseline.fit_residuals.size());
+  const double n_eff = residual_count / deff;
+  const double baseline_bic = information_criterion(baseline, residual_count, n_eff);
+
   std::vector<Ranked> ranked;
   for (std::size_t e = 0; e < effects.size(); ++e) {
     const Fit& f = fits[e];
-    double significance = 0;
+    Ranked r;
+    r.index = e;
     for (std::size_t p = 0; p < f.values.size(); ++p) {
       const EffectParameter& parameter = effects[e].parameters[p];
       // A per-patch stiffness is tested against the bulk msm_beta, others against their null.
       const double null_value = effects[e].replaces_beta ? f.beta : parameter.null_value;
-      if (std::isfinite(null_value) && std::isfinite(f.std[p]) && f.std[p] > 0) {
-        significance = std::max(significance, std::abs(f.values[p] - null_value) / f.std[p]);
+      const double std = f.std[p] * std::sqrt(deff);
+      if (std::isfinite(null_value) && std::isfinite(std) && std > 0) {
+        r.significance = std::max(r.significance, std::abs(f.values[p] - null_value) / std);
       }
     }
-    const double improvement = out.baseline.rms > 0 ? 1.0 - f.score.held_rms() / out.baseline.rms : 0.0;
-    const bool passes = misfit >= kMinMisfit && improvement >= kMinImprovement && baseline.bic - f.bic >= kMinBicGain &&
-                        significance >= kMinSignificance;
-    ranked.push_back({e, significance, passes});
+    r.improvement = out.baseline.rms > 0 ? 1.0 - f.score.held_rms() / out.baseline.rms : 0.0;
+    r.bic = information_criterion(f, residual_count, n_eff);
+    r.explained = explained_share(out.baseline.rms, f.score.held_rms(), noise_rms);
+    r.clear = misfit >= kMinMisfit && r.improvement >= kMinImprovement && baseline_bic - r.bic >= kMinBicGain &&
+              r.significance >= kMinSignificance;
+    r.passes = r.clear && r.explained >= min_explained_share;
+    ranked.push_back(r);
   }
   std::sort(ranked.begin(), ranked.end(), [&](const Ranked& a, const Ranked& b) {
     if (a.passes != b.passes) return a.passes;
@@ -615,16 +943,27 @@ DiagnoseResult diagnose_recording(const Recording& recording, const DiagnoseOpti
     c.effect = effects[r.index].name;
     for (std::size_t p = 0; p < f.values.size(); ++p) {
       c.parameters[effects[r.index].parameters[p].name] = f.values[p];
-      c.parameter_std[effects[r.index].parameters[p].name] = f.std[p];
+      c.parameter_std[effects[r.index].parameters[p].name] = f.std[p] * std::sqrt(deff);
     }
     c.parameters["msm_beta"] = f.beta;
-    c.parameter_std["msm_beta"] = f.beta_std;
+    c.parameter_std["msm_beta"] = f.beta_std * std::sqrt(deff);
+    if (f.form.fit_alpha) {
+      c.parameters["msm_alpha"] = f.alpha;
+      c.parameter_std["msm_alpha"] = f.alpha_std * std::sqrt(deff);
+    }
     c.rms = f.score.held_rms();
-    c.bic = f.bic;
+    c.bic = r.bic;
+    c.explained = r.explained;
     out.candidates.push_back(c);
   }
 
-  const bool found = !ranked.empty() && ranked.front().passes;
+  const bool passes = !ranked.empty() && ranked.front().passes;
+  const Stability stability = passes ? selection_stability(scorer, baseline, fits, ranked) : Stability{};
+  const bool found = passes && stability.explains >= kStableShare;
+  if (passes) {
+    out.selection_stability = stability.explains;
+    if (stability.rival_share >= kRivalShare) out.runner_up = effects[stability.rival].name;
+  }
   const std::vector<double> baseline_map = magnitudes(recording, baseline.simulated);
   const double t0 = out.location.t_start;
   const double t1 = out.location.t_end;
@@ -639,11 +978,14 @@ DiagnoseResult diagnose_recording(const Recording& recording, const DiagnoseOpti
     const Fit& f = fits[best.index];
     out.verdict = "missing_physics";
     out.effect = effect.name;
-    out.augmented.model = "msm";
-    out.augmented.parameters = out.candidates.front().parameters;
+    out.augmented =
+        msm_model(f, f.form,
+                  f.form.steps_per_frame == form.form.steps_per_frame && f.form.fit_alpha == form.form.fit_alpha &&
+                          f.form.cluster_radius_factor == form.form.cluster_radius_factor
+                      ? form.reason
+                      : "the plain form fitted the effect better than the baseline's");
+    for (const auto& [name, value] : out.candidates.front().parameters) out.augmented.parameters[name] = value;
     out.augmented.parameter_std = out.candidates.front().parameter_std;
-    out.augmented.parameters["msm_alpha"] = 1.0;
-    out.augmented.rms = f.score.held_rms();
     out.improvement = 1.0 - out.augmented.rms / out.baseline.rms;
     std::ostringstream text;
     text << "The elastic model misses " << (where.str().empty() ? std::string("the motion") : where.str()) << " by "
@@ -651,25 +993,45 @@ DiagnoseResult diagnose_recording(const Recording& recording, const DiagnoseOpti
          << effect.physics << " explains it, cutting the held-out rms by " << number(100.0 * out.improvement)
          << " % and moving msm_beta from " << number(baseline.beta) << " to " << number(f.beta) << ".";
     if (effect.replaces_beta) text << " " << describe_region(context.patches, split_patches(context.patches, f.values));
-    if (ranked.size() > 1 && ranked[1].passes && fits[ranked[1].index].bic - f.bic < 6.0) {
-      text << " " << effects[ranked[1].index].name << " fits almost as well; " << effect.experiment << ".";
+    const bool close_rival = ranked.size() > 1 && ranked[1].passes && ranked[1].bic - best.bic < 6.0;
+    if (!out.runner_up.empty() || close_rival) {
+      const std::string rival = !out.runner_up.empty() ? out.runner_up : effects[ranked[1].index].name;
+      if (out.runner_up.empty()) out.runner_up = rival;
+      text << " " << rival << " fits almost as well; " << effect.experiment << ".";
     }
     out.explanation = text.str();
     result.evidence.simulated_augmented = f.simulated;
   } else {
     out.augmented = out.baseline;
     out.improvement = 0;
+    // The best effect that improved the fit clearly without being named, and why not.
+    std::string unstable;
+    if (passes) {
+      unstable = " " + effects[ranked.front().index].name + " improves the fit on some held-out frames but not on " +
+                 number(100.0 * kStableShare) + " % of resamples of them (" + number(100.0 * stability.explains) +
+                 " %).";
+    } else {
+      for (const Ranked& r : ranked) {
+        if (!r.clear) continue;
+        unstable = " " + effects[r.index].name + " improves the held-out rms by " + number(100.0 * r.improvement) +
+                   " % but explains only " + number(100.0 * r.explained) +
+                   " % of the misfit beyond the noise: the rest is not a catalogued effect, or the model's form "
+                   "is off.";
+        break;
+      }
+    }
     if (misfit >= kUnknownMisfit && !out.location.particles.empty()) {
       out.verdict = "missing_physics";
       out.effect = "unknown";
       out.explanation = "The elastic model misses " + where.str() + " by " + number(out.baseline.rms) + " " +
                         recording.length_unit + " rms, " + number(misfit) +
-                        " times the noise, and no catalogued effect explains it clearly.";
+                        " times the noise, and no catalogued effect explains it clearly." + unstable;
     } else {
       out.verdict = "consistent";
       out.effect = "none";
       out.explanation = "The elastic model explains the recording to within " + number(misfit) +
-                        " times the measurement noise on held-out frames; no added physics improves it clearly.";
+                        " times the measurement noise on held-out frames; no added physics improves it clearly." +
+                        unstable;
     }
     result.evidence.simulated_augmented = baseline.simulated;
   }
@@ -690,7 +1052,8 @@ DiagnoseResult diagnose_recording(const Recording& recording, const DiagnoseOpti
   ev.driven.erase(std::unique(ev.driven.begin(), ev.driven.end()), ev.driven.end());
   ev.signatures = signatures;
   ev.signatures["misfit_over_noise"] = misfit;
-  ev.signatures["simulations"] = fitter.evaluations;
+  ev.signatures["simulations"] = fitter.evaluations + (plain_fitter ? plain_fitter->evaluations : 0);
+  ev.signatures["design_effect"] = deff;
   result.runtime_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;
 }
@@ -702,11 +1065,18 @@ nlohmann::json diagnosis_json(const Diagnosis& d) {
     nlohmann::json j{{"model", m.model}, {"parameters", m.parameters}, {"rms", nullptr}};
     if (std::isfinite(m.rms)) j["rms"] = m.rms;
     if (std::isfinite(m.force_rms)) j["force_rms"] = m.force_rms;
+    if (m.steps_per_frame > 0) {
+      j["form"] = {{"steps_per_frame", m.steps_per_frame},
+                   {"msm_alpha", m.alpha_fitted ? "fitted" : "held"},
+                   {"cluster_radius_factor", m.cluster_radius_factor},
+                   {"reason", m.form_reason}};
+    }
     return j;
   };
   nlohmann::json candidates = nlohmann::json::array();
   for (const Candidate& c : d.candidates) {
     nlohmann::json j{{"effect", c.effect}, {"rms", nullptr}, {"bic", c.bic}, {"parameters", c.parameters}};
+    if (std::isfinite(c.explained)) j["explained"] = c.explained;
     if (std::isfinite(c.rms)) j["rms"] = c.rms;
     if (std::isfinite(c.force_rms)) j["force_rms"] = c.force_rms;
     candidates.push_back(j);
@@ -726,6 +1096,12 @@ nlohmann::json diagnosis_json(const Diagnosis& d) {
       {"candidates", candidates}};
   if (!std::isfinite(d.noise_rms)) document["noise_rms"] = nullptr;
   if (std::isfinite(d.force_noise_rms)) document["force_noise_rms"] = d.force_noise_rms;
+  if (std::isfinite(d.selection_stability) || !d.runner_up.empty()) {
+    nlohmann::json selection = nlohmann::json::object();
+    if (std::isfinite(d.selection_stability)) selection["stability"] = d.selection_stability;
+    selection["runner_up"] = d.runner_up.empty() ? nlohmann::json() : nlohmann::json(d.runner_up);
+    document["selection"] = selection;
+  }
   return document;
 }
 
@@ -757,9 +1133,11 @@ std::string diagnosis_summary(const Diagnosis& d, const std::string& length_unit
     out << "  " << d.explanation << "\n";
     return out.str();
   }
-  out << "\n  baseline msm_beta " << number(d.baseline.parameters.at("msm_beta")) << ", held-out rms "
-      << number(d.baseline.rms) << " " << length_unit << ", noise " << number(d.noise_rms) << " " << length_unit
-      << "\n";
+  out << "\n  baseline msm_beta " << number(d.baseline.parameters.at("msm_beta")) << ", msm_alpha "
+      << number(d.baseline.parameters.at("msm_alpha")) << (d.baseline.alpha_fitted ? " (fitted)" : " (held)") << ", "
+      << d.baseline.steps_per_frame << (d.baseline.steps_per_frame == 1 ? " step" : " steps")
+      << " per frame, held-out rms " << number(d.baseline.rms) << " " << length_unit << ", noise "
+      << number(d.noise_rms) << " " << length_unit << "\n";
   if (d.verdict == "missing_physics" && d.effect != "unknown") {
     out << "  with " << d.effect << ": held-out rms " << number(d.augmented.rms) << " " << length_unit
         << " (improvement " << number(100.0 * d.improvement) << " %)\n";

@@ -1117,6 +1117,8 @@ DiagnoseResult diagnose_recording_fem(const Recording& recording, const Diagnose
   struct Ranked {
     std::size_t index;
     double significance;
+    double explained;  // share of the whitened misfit beyond noise removed
+    bool clear;        // passes every test but min_explained_share
     bool passes;
   };
   std::vector<Ranked> ranked;
@@ -1132,9 +1134,11 @@ DiagnoseResult diagnose_recording_fem(const Recording& recording, const Diagnose
       }
     }
     const double improvement = base_chi > 0 ? 1.0 - f.score.chi() / base_chi : 0.0;
-    const bool passes = misfit >= kMinMisfit && improvement >= kMinImprovement && baseline.bic - f.bic >= kMinBicGain &&
-                        significance >= kMinSignificance;
-    ranked.push_back({e, significance, passes});
+    // chi is whitened by the noise: a perfect model shows 1.
+    const double explained = explained_share(base_chi, f.score.chi(), 1.0);
+    const bool clear = misfit >= kMinMisfit && improvement >= kMinImprovement && baseline.bic - f.bic >= kMinBicGain &&
+                       significance >= kMinSignificance;
+    ranked.push_back({e, significance, explained, clear, clear && explained >= min_explained_share});
   }
   std::sort(ranked.begin(), ranked.end(), [&](const Ranked& a, const Ranked& b) {
     if (a.passes != b.passes) return a.passes;
@@ -1153,6 +1157,7 @@ DiagnoseResult diagnose_recording_fem(const Recording& recording, const Diagnose
     c.rms = f.score.rms();
     c.force_rms = f.score.force_rms();
     c.bic = f.bic;
+    c.explained = r.explained;
     out.candidates.push_back(c);
   }
 
@@ -1243,16 +1248,28 @@ DiagnoseResult diagnose_recording_fem(const Recording& recording, const Diagnose
   } else {
     out.augmented = out.baseline;
     out.improvement = 0;
+    // An effect that improved the fit clearly but left too much of the misfit: say so.
+    std::string partial;
+    for (const Ranked& r : ranked) {
+      if (!r.clear) continue;
+      partial = " " + effects[r.index].name + " improves the held-out " + misfit_kind + " by " +
+                number(100.0 * (1.0 - fits[r.index].score.chi() / base_chi)) + " % but explains only " +
+                number(100.0 * r.explained) +
+                " % of the misfit beyond the noise: the rest is not a catalogued effect, or the model's form is off "
+                "(on a coarse mesh, the mesh itself).";
+      break;
+    }
     if (misfit >= kUnknownMisfit && !out.location.particles.empty()) {
       out.verdict = "missing_physics";
       out.effect = "unknown";
       out.explanation = "The linear FEM misses " + where.str() + " by " + size.str() + ", " + number(misfit) +
-                        " times the noise, and no catalogued effect explains it clearly.";
+                        " times the noise, and no catalogued effect explains it clearly." + partial;
     } else {
       out.verdict = "consistent";
       out.effect = "none";
       out.explanation = "The linear FEM explains the recording to within " + number(misfit) +
-                        " times the measurement noise on held-out frames; no added physics improves it clearly.";
+                        " times the measurement noise on held-out frames; no added physics improves it clearly." +
+                        partial;
     }
   }
 

@@ -59,4 +59,10 @@ double residual_rms(const std::vector<double>& observed, const std::vector<doubl
   return std::sqrt(sum / static_cast<double>(pairs));
 }
 
+double explained_share(double baseline_rms, double fit_rms, double noise_rms) {
+  const double excess = baseline_rms * baseline_rms - noise_rms * noise_rms;
+  if (!(excess > 0)) return 0.0;
+  return 1.0 - std::max(0.0, fit_rms * fit_rms - noise_rms * noise_rms) / excess;
+}
+
 }  // namespace pliant::host

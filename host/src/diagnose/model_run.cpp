@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
+
+#include "pliant/core/deformability.hpp"
 
 namespace pliant::host {
 namespace {
@@ -53,8 +56,8 @@ struct SimulatorImpl {
   std::unique_ptr<HostMsmModel<Dim>> model;
   std::vector<unsigned char> state_block;
 
-  explicit SimulatorImpl(const Recording& recording) {
-    model = build_msm_model<Dim>(recording, MsmSetupOptions{});
+  SimulatorImpl(const Recording& recording, const MsmSetupOptions& setup) {
+    model = build_msm_model<Dim>(recording, setup);
     state_block.resize(msm_state_workspace_size(model->model));
   }
 
@@ -111,15 +114,18 @@ struct SimulatorImpl {
       }
     };
     // Driven targets: a window's particle follows its observation, holding the last observed
-    // position (or where it was when the window opened) through occlusions.
+    // position (or where it was when the window opened) through occlusions. `starts` keeps where
+    // each target begins the frame interval, for the interpolated targets of several steps.
     const std::vector<DrivenWindow>& windows = model->driven;
     std::vector<Vec> held(windows.size(), Vec::Zero());
     std::vector<unsigned char> active(windows.size(), 0);
     std::vector<int> ids;
     std::vector<Vec> targets;
+    std::vector<Vec> starts;
     auto gather = [&](int frame) {
       ids.clear();
       targets.clear();
+      starts.clear();
       const double t = recording.frame_times_s[static_cast<std::size_t>(frame)];
       for (std::size_t w = 0; w < windows.size(); ++w) {
         const DrivenWindow& window = windows[w];
@@ -129,6 +135,7 @@ struct SimulatorImpl {
         }
         if (active[w] == 0) held[w] = state.position[window.id];
         active[w] = 1;
+        starts.push_back(held[w]);
         if (recording.observed(frame, window.id)) {
           for (int d = 0; d < Dim; ++d) held[w](d) = recording.position(frame, window.id, d);
         }
@@ -136,17 +143,34 @@ struct SimulatorImpl {
         targets.push_back(held[w]);
       }
     };
+    const int steps = settings.steps_per_frame;
+    std::vector<Vec> step_targets;
+    auto step = [&](const MsmStepInput<Dim, double>& input) {
+      const Status status = msm_step(m, params, input, state);
+      if (status == Status::invalid_argument || status == Status::not_initialized) {
+        require_ok(status, "simulation step");
+      }
+    };
     gather(0);
     record(0);
     for (int k = 1; k < frames; ++k) {
       gather(k);
+      const double dt = recording.frame_times_s[static_cast<std::size_t>(k)] -
+                        recording.frame_times_s[static_cast<std::size_t>(k - 1)];
       MsmStepInput<Dim, double> input;
-      input.dt = recording.frame_times_s[static_cast<std::size_t>(k)] -
-                 recording.frame_times_s[static_cast<std::size_t>(k - 1)];
-      input.driven = {ids.data(), targets.data(), static_cast<int>(ids.size())};
-      const Status status = msm_step(m, params, input, state);
-      if (status == Status::invalid_argument || status == Status::not_initialized) {
-        require_ok(status, "simulation step");
+      input.dt = dt / steps;
+      if (steps == 1) {
+        input.driven = {ids.data(), targets.data(), static_cast<int>(ids.size())};
+        step(input);
+      } else {
+        step_targets.resize(targets.size());
+        input.driven = {ids.data(), step_targets.data(), static_cast<int>(ids.size())};
+        for (int j = 1; j <= steps; ++j) {
+          const double share = static_cast<double>(j) / steps;
+          for (std::size_t c = 0; c < targets.size(); ++c)
+            step_targets[c] = starts[c] + (targets[c] - starts[c]) * share;
+          step(input);
+        }
       }
       record(k);
     }
@@ -163,12 +187,12 @@ struct RecordingSimulator::Impl3 : SimulatorImpl<3> {
   using SimulatorImpl<3>::SimulatorImpl;
 };
 
-RecordingSimulator::RecordingSimulator(const Recording& recording)
+RecordingSimulator::RecordingSimulator(const Recording& recording, const MsmSetupOptions& setup)
     : recording_(recording), support_normal_(support_normal_of(recording)) {
   if (recording.dimension == 2) {
-    impl2_ = std::make_unique<Impl2>(recording);
+    impl2_ = std::make_unique<Impl2>(recording, setup);
   } else if (recording.dimension == 3) {
-    impl3_ = std::make_unique<Impl3>(recording);
+    impl3_ = std::make_unique<Impl3>(recording, setup);
   } else {
     throw std::runtime_error("dimension must be 2 or 3");
   }
@@ -177,6 +201,9 @@ RecordingSimulator::RecordingSimulator(const Recording& recording)
 RecordingSimulator::~RecordingSimulator() = default;
 
 std::vector<double> RecordingSimulator::simulate(const ModelSettings& settings) const {
+  if (settings.steps_per_frame < 1 || settings.steps_per_frame > max_steps_per_frame) {
+    throw std::runtime_error("steps per frame must be 1.." + std::to_string(max_steps_per_frame));
+  }
   if (settings.support_friction >= 0) {
     double length = 0;
     for (double v : support_normal_) length += v * v;

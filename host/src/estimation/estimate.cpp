@@ -172,7 +172,8 @@ constexpr double kExplainedByNoise = 1.5;
 
 bool explained_by_noise(double rms, double noise_std) { return noise_std > 0 && rms <= kExplainedByNoise * noise_std; }
 
-std::string choice_reason(const BaselineChoice& choice, bool compared_alpha, bool compared_steps) {
+std::string choice_reason(const BaselineChoice& choice, bool compared_alpha, bool compared_steps,
+                          bool compared_radius) {
   const BaselineCandidate& kept = choice.candidates[static_cast<std::size_t>(choice.chosen)];
   // The runner-up: the best-scoring variant other than the one kept.
   const BaselineCandidate* next = nullptr;
@@ -180,66 +181,125 @@ std::string choice_reason(const BaselineChoice& choice, bool compared_alpha, boo
     if (static_cast<int>(i) == choice.chosen) continue;
     if (next == nullptr || choice.candidates[i].bic < next->bic) next = &choice.candidates[i];
   }
-  char text[320];
-  std::snprintf(text, sizeof text, "%s at %.3f, %d step%s per frame", kept.alpha_fitted ? "fitted" : "held",
-                kept.msm_alpha, kept.steps_per_frame, kept.steps_per_frame == 1 ? "" : "s");
-  std::string reason = text;
+  auto describe = [&](const BaselineCandidate& c, bool with_value) {
+    char text[160];
+    if (with_value) {
+      std::snprintf(text, sizeof text, "%s at %.3f, %d step%s per frame", c.alpha_fitted ? "fitted" : "held",
+                    c.msm_alpha, c.steps_per_frame, c.steps_per_frame == 1 ? "" : "s");
+    } else {
+      std::snprintf(text, sizeof text, "%s, %d per frame", c.alpha_fitted ? "fitted" : "held", c.steps_per_frame);
+    }
+    std::string out = text;
+    if (compared_radius) {
+      std::snprintf(text, sizeof text, ", cluster radius %g", c.cluster_radius_factor);
+      out += text;
+    }
+    return out;
+  };
+  std::string reason = describe(kept, true);
   if (next == nullptr) return reason;
-  const char* what = compared_alpha && compared_steps ? "msm_alpha and steps per frame"
-                     : compared_alpha                 ? "msm_alpha"
-                                                      : "steps per frame";
-  std::snprintf(text, sizeof text,
-                ": chosen over %zu variants of %s by BIC, %.1f below the next best (%s, %d per frame) over %.0f "
-                "effective residuals",
-                choice.candidates.size(), what, next->bic - kept.bic, next->alpha_fitted ? "fitted" : "held",
-                next->steps_per_frame, choice.effective_residuals);
-  return reason + text;
+  std::vector<std::string> compared;
+  if (compared_alpha) compared.push_back("msm_alpha");
+  if (compared_steps) compared.push_back("steps per frame");
+  if (compared_radius) compared.push_back("cluster radius");
+  std::string what;
+  for (std::size_t i = 0; i < compared.size(); ++i) {
+    what += (i == 0 ? "" : (i + 1 == compared.size() ? " and " : ", ")) + compared[i];
+  }
+  char text[200];
+  std::snprintf(text, sizeof text, ": chosen over %zu variants of %s by BIC, %.1f below the next best (",
+                choice.candidates.size(), what.c_str(), next->bic - kept.bic);
+  reason += text;
+  std::snprintf(text, sizeof text, ") over %.0f effective residuals", choice.effective_residuals);
+  return reason + describe(*next, false) + text;
 }
 
-// Fits the baseline variants `options` asks for and keeps the best: automatic steps per frame
-// tries 1..max_auto_steps_per_frame, automatic msm_alpha held and fitted at each, unless the
-// first (simplest) variant is explained to the measured noise.
+// Fits the baseline variants `options` asks for and keeps the best (docs/estimation.md):
+// 1. the simplest variant (msm_alpha held, the first steps per frame, the setup's cluster
+//    radius); kept at once when it fits to the measured noise;
+// 2. at the current radius, every steps per frame (automatic: 1..max_auto_steps_per_frame) with
+//    msm_alpha held and fitted as the options say;
+// 3. with the cluster radius automatic, the steps and msm_alpha mode kept so far at every radius
+//    of the setup's and auto_cluster_radii;
+// 4. when step 3 moved the radius, steps 2 and 3 again from there (at most twice more): the
+//    radius trades off against msm_alpha and the steps, so each is chosen given the other.
+// Every variant is fitted once. `model` is replaced by the model of the radius kept.
 template <int Dim>
-MsmFit<Dim> fit_baseline(const Recording& recording, const EstimateOptions& options, const HostMsmModel<Dim>& model,
-                         BaselineChoice& choice, StagedProgress& progress) {
+MsmFit<Dim> fit_baseline(const Recording& recording, const EstimateOptions& options,
+                         std::unique_ptr<HostMsmModel<Dim>>& model, BaselineChoice& choice, StagedProgress& progress) {
   const bool trajectory = options.mode == FitMode::trajectory;
   const bool alpha_auto = trajectory && options.alpha == AlphaMode::automatic;
   const bool alpha_fit = trajectory && options.alpha == AlphaMode::fitted;
   const bool steps_auto = trajectory && options.steps_per_frame == 0;
-  std::vector<MsmFit<Dim>> fits;
-  auto add = [&](int steps, bool fit_alpha) {
-    fits.push_back(fit_msm<Dim>(recording, options, model, steps, fit_alpha, options.msm_alpha, &progress));
-    ++progress.stage;
-    const DeformabilityResult& r = fits.back().result;
-    choice.candidates.push_back({steps, fit_alpha, r.msm_alpha, r.msm_beta, r.rms, 0.0});
-  };
+  const bool radius_auto =
+      trajectory && options.cluster_radius_auto && options.setup.clusters.layout == ClusterLayout::radius;
+  const double setup_radius = options.setup.clusters.radius_factor;
   const int first_steps = trajectory && options.steps_per_frame > 0 ? options.steps_per_frame : 1;
   const int last_steps = steps_auto ? max_auto_steps_per_frame : first_steps;
-  for (int steps = first_steps; steps <= last_steps; ++steps) {
-    if (!alpha_fit) add(steps, false);
-    if (steps == first_steps && !alpha_fit && (alpha_auto || steps_auto) &&
-        explained_by_noise(fits.front().result.rms, model.noise_std)) {
-      score_candidates<Dim>(fits, choice);
-      char text[200];
-      std::snprintf(text, sizeof text,
-                    "held at %.3f, %d step%s per frame: it fits to within %.1f times the measured noise (rms %.3g, "
-                    "noise %.3g), nothing left for msm_alpha or steps per frame to explain",
-                    fits.front().result.msm_alpha, first_steps, first_steps == 1 ? "" : "s", kExplainedByNoise,
-                    fits.front().result.rms, model.noise_std);
-      choice.reason = text;
-      return std::move(fits.front());
+
+  // Models by cluster radius, built when first needed; the setup's own is `model`.
+  std::vector<std::pair<double, std::unique_ptr<HostMsmModel<Dim>>>> models;
+  models.emplace_back(setup_radius, std::move(model));
+  auto model_for = [&](double radius) -> const HostMsmModel<Dim>& {
+    for (auto& [r, m] : models) {
+      if (r == radius) return *m;
     }
-    if (alpha_auto || alpha_fit) add(steps, true);
+    MsmSetupOptions setup = options.setup;
+    setup.clusters.radius_factor = radius;
+    models.emplace_back(radius, build_msm_model<Dim>(recording, setup));
+    return *models.back().second;
+  };
+
+  std::vector<MsmFit<Dim>> fits;
+  auto add = [&](int steps, bool fit_alpha, double radius) {
+    for (const BaselineCandidate& c : choice.candidates) {
+      if (c.steps_per_frame == steps && c.alpha_fitted == fit_alpha && c.cluster_radius_factor == radius) return;
+    }
+    fits.push_back(fit_msm<Dim>(recording, options, model_for(radius), steps, fit_alpha, options.msm_alpha, &progress));
+    ++progress.stage;
+    const DeformabilityResult& r = fits.back().result;
+    choice.candidates.push_back({steps, fit_alpha, r.msm_alpha, r.msm_beta, r.rms, 0.0, radius});
     score_candidates<Dim>(fits, choice);
-  }
-  if (!trajectory) {
-    choice.reason = "held: the final equilibrium does not depend on msm_alpha or steps per frame";
-  } else if (choice.candidates.size() == 1) {
-    choice.reason = std::string(options.alpha == AlphaMode::fitted ? "fitted" : "held") + " as asked (--alpha " +
-                    alpha_mode_name(options.alpha) + "), " + std::to_string(first_steps) + " step" +
-                    (first_steps == 1 ? "" : "s") + " per frame";
+  };
+  auto kept = [&]() { return choice.candidates[static_cast<std::size_t>(choice.chosen)]; };
+
+  add(first_steps, alpha_fit, setup_radius);
+  const bool choosing = alpha_auto || steps_auto || radius_auto;
+  if (choosing && !alpha_fit && explained_by_noise(fits.front().result.rms, models.front().second->noise_std)) {
+    char text[240];
+    std::snprintf(text, sizeof text,
+                  "held at %.3f, %d step%s per frame: it fits to within %.1f times the measured noise (rms %.3g, "
+                  "noise %.3g), nothing left for msm_alpha, steps per frame or cluster radius to explain",
+                  fits.front().result.msm_alpha, first_steps, first_steps == 1 ? "" : "s", kExplainedByNoise,
+                  fits.front().result.rms, models.front().second->noise_std);
+    choice.reason = text;
   } else {
-    choice.reason = choice_reason(choice, alpha_auto, steps_auto);
+    double radius = setup_radius;
+    for (int round = 0; round < 3; ++round) {
+      for (int steps = first_steps; steps <= last_steps; ++steps) {
+        if (!alpha_fit) add(steps, false, radius);
+        if (alpha_auto || alpha_fit) add(steps, true, radius);
+      }
+      if (!radius_auto) break;
+      const BaselineCandidate form = kept();
+      add(form.steps_per_frame, form.alpha_fitted, setup_radius);
+      for (double other : auto_cluster_radii) add(form.steps_per_frame, form.alpha_fitted, other);
+      if (kept().cluster_radius_factor == radius) break;
+      radius = kept().cluster_radius_factor;
+    }
+    if (!trajectory) {
+      choice.reason = "held: the final equilibrium does not depend on msm_alpha or steps per frame";
+    } else if (choice.candidates.size() == 1) {
+      choice.reason = std::string(options.alpha == AlphaMode::fitted ? "fitted" : "held") + " as asked (--alpha " +
+                      alpha_mode_name(options.alpha) + "), " + std::to_string(first_steps) + " step" +
+                      (first_steps == 1 ? "" : "s") + " per frame";
+    } else {
+      choice.reason = choice_reason(choice, alpha_auto, steps_auto, radius_auto);
+    }
+  }
+  const double kept_radius = kept().cluster_radius_factor;
+  for (auto& [r, m] : models) {
+    if (r == kept_radius) model = std::move(m);
   }
   return std::move(fits[static_cast<std::size_t>(choice.chosen)]);
 }
@@ -251,16 +311,22 @@ EstimateReport run(const Recording& recording, const EstimateOptions& options) {
   const bool trajectory = options.mode == FitMode::trajectory;
   const int alpha_variants = trajectory && options.alpha == AlphaMode::automatic ? 2 : 1;
   const int step_variants = trajectory && options.steps_per_frame == 0 ? max_auto_steps_per_frame : 1;
+  const int radius_variants =
+      trajectory && options.cluster_radius_auto && options.setup.clusters.layout == ClusterLayout::radius
+          ? static_cast<int>(std::size(auto_cluster_radii))
+          : 0;
   const int noise_stages = options.input_noise_samples >= 2 ? options.input_noise_samples : 0;
-  StagedProgress staged{options.progress, options.progress_context, 0, alpha_variants * step_variants + noise_stages};
+  StagedProgress staged{options.progress, options.progress_context, 0,
+                        alpha_variants * step_variants + radius_variants + noise_stages};
 
   EstimateReport report;
-  MsmFit<Dim> fit = fit_baseline<Dim>(recording, options, *model, report.baseline, staged);
+  MsmFit<Dim> fit = fit_baseline<Dim>(recording, options, model, report.baseline, staged);
   const int fits = staged.stage;
   report.result = fit.result;
   report.curve_beta = std::move(fit.curve_beta);
   report.curve_error = std::move(fit.curve_error);
   report.cluster_count = model->model.cluster_count;
+  report.cluster_radius_factor = report.baseline.cluster_radius_factor(options.setup.clusters.radius_factor);
   report.rest_frames = model->rest_frames;
   report.spacing = model->model.spacing;
   const int frames = recording.frame_count();
@@ -275,6 +341,8 @@ EstimateReport run(const Recording& recording, const EstimateOptions& options) {
   refit.alpha = AlphaMode::fixed;
   refit.msm_alpha = report.result.msm_alpha;
   refit.steps_per_frame = report.baseline.steps_per_frame();
+  refit.cluster_radius_auto = false;
+  refit.setup.clusters.radius_factor = report.cluster_radius_factor;
   report.msm_beta_std_input = input_noise_std<Dim>(recording, refit, *model, report.noise_std, staged, fits);
   report.msm_beta_std = std::hypot(report.msm_beta_std_curvature, report.msm_beta_std_input);
   report.runtime_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
@@ -359,7 +427,9 @@ nlohmann::json estimate_json(const Recording& recording, const EstimateOptions& 
       {"cluster_layout", options.setup.clusters.layout == ClusterLayout::radius      ? "radius"
                          : options.setup.clusters.layout == ClusterLayout::k_nearest ? "k_nearest"
                                                                                      : "grid_blocks"},
-      {"cluster_radius_factor", options.setup.clusters.radius_factor},
+      {"cluster_radius_factor", report.cluster_radius_factor},
+      {"cluster_radius_mode",
+       options.cluster_radius_auto && options.setup.clusters.layout == ClusterLayout::radius ? "auto" : "fixed"},
       {"driven_mass_factor", options.setup.driven_mass_factor},
       {"rest_source", options.setup.rest == RestSource::still_frames ? "still_frames" : "first_frame"},
       {"rest_frames", report.rest_frames},
@@ -373,6 +443,7 @@ nlohmann::json estimate_json(const Recording& recording, const EstimateOptions& 
   for (const BaselineCandidate& c : report.baseline.candidates) {
     candidates.push_back({{"steps_per_frame", c.steps_per_frame},
                           {"msm_alpha_fitted", c.alpha_fitted},
+                          {"cluster_radius_factor", c.cluster_radius_factor},
                           {"msm_alpha", c.msm_alpha},
                           {"msm_beta", c.msm_beta},
                           {"rms", c.rms},

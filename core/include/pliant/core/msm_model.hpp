@@ -12,8 +12,9 @@
 //
 // Clusters (Mueller et al. 2005, cluster shape matching): by default one cluster per
 // particle holding every particle within radius_factor (1.5) x the median nearest-neighbour
-// distance of the rest shape. Alternatives: the particle and its k nearest neighbours, or the
-// paper's overlapping rectangular blocks (3 wide x 2 tall) on a particle grid.
+// distance of the rest shape (a particle with no neighbour that close, but one within twice
+// that, takes radius_factor x its own nearest-neighbour distance). Alternatives: the particle and its k nearest
+// neighbours, or the paper's overlapping rectangular blocks (3 wide x 2 tall) on a particle grid.
 #pragma once
 
 #include <cstddef>
@@ -113,7 +114,8 @@ std::size_t msm_model_workspace_size(const MsmModelConfig<Dim, Scalar>& config) 
 
 /// Builds the model in `arena`. Errors: invalid_argument (N < 1, bad cluster options, ids out
 /// of range), non_finite_input, invalid_mass, duplicate_rest_positions, degenerate_cluster (a
-/// cluster with a single member cannot define a rotation), capacity_exceeded (arena too small).
+/// cluster with a single member cannot define a rotation: a particle farther than twice the
+/// cluster radius from every other), capacity_exceeded (arena too small).
 /// On error the model is left uninitialized.
 template <int Dim, typename Scalar>
 [[nodiscard]] Status msm_model_init(Arena& arena, const MsmModelConfig<Dim, Scalar>& config,

@@ -30,6 +30,11 @@ enum class AlphaMode : std::uint8_t { automatic, fitted, fixed };
 /// Largest MSM steps per frame interval the automatic choice tries.
 inline constexpr int max_auto_steps_per_frame = 4;
 
+/// Cluster radii (times the median nearest-neighbour distance of the rest shape) the automatic
+/// choice tries besides the setup's own (1.5 by default): the spread seen between objects and
+/// simulators that were not ours, in steps the fit can tell apart.
+inline constexpr double auto_cluster_radii[] = {1.3, 1.75, 2.0, 2.25};
+
 struct EstimateOptions {
   FitMode mode = FitMode::trajectory;
   AlphaMode alpha = AlphaMode::automatic;
@@ -37,6 +42,9 @@ struct EstimateOptions {
   /// Trajectory mode: MSM steps per frame interval. 0 = chosen by the baseline selection among
   /// 1..max_auto_steps_per_frame; else held at that value (1..max_steps_per_frame).
   int steps_per_frame = 0;
+  /// Trajectory mode, radius cluster layout: also try auto_cluster_radii and keep the best (BIC);
+  /// false holds setup.clusters.radius_factor.
+  bool cluster_radius_auto = true;
   int grid_points = 11;
   double tolerance = 1e-3;
   MsmSetupOptions setup;
@@ -56,6 +64,7 @@ struct BaselineCandidate {
   double msm_beta = 0;
   double rms = 0;  ///< rms position residual per coordinate, length unit
   double bic = 0;  ///< Bayesian information criterion over the effective residuals (lower is better)
+  double cluster_radius_factor = 1.5;  ///< cluster radius / median nearest-neighbour distance
 };
 
 /// How the baseline was chosen: every variant fitted, the one kept, and why (docs/estimation.md).
@@ -69,6 +78,10 @@ struct BaselineChoice {
   }
   int steps_per_frame() const {
     return candidates.empty() ? 1 : candidates[static_cast<std::size_t>(chosen)].steps_per_frame;
+  }
+  /// The kept variant's cluster radius factor; `fallback` when nothing was fitted.
+  double cluster_radius_factor(double fallback) const {
+    return candidates.empty() ? fallback : candidates[static_cast<std::size_t>(chosen)].cluster_radius_factor;
   }
 };
 
@@ -85,13 +98,14 @@ struct EstimateReport {
   std::vector<double> curve_beta;
   std::vector<double> curve_error;
   int cluster_count = 0;
-  int rest_frames = 1;                ///< leading still frames averaged into the rest shape
-  double noise_std = 0;               ///< position noise used for the input perturbation
-  double msm_beta_std_curvature = 0;  ///< from the error curve alone (core estimator)
-  double msm_beta_std_input = 0;      ///< spread of refits under perturbed inputs
-  double msm_beta_std = 0;            ///< combined: sqrt(curvature^2 + input^2)
-  double spacing = 0;                 ///< median nearest-neighbour distance of the rest shape
-  double frame_interval_s = 0;        ///< mean time step used by the simulation
+  double cluster_radius_factor = 1.5;  ///< of the kept variant (radius layout)
+  int rest_frames = 1;                 ///< leading still frames averaged into the rest shape
+  double noise_std = 0;                ///< position noise used for the input perturbation
+  double msm_beta_std_curvature = 0;   ///< from the error curve alone (core estimator)
+  double msm_beta_std_input = 0;       ///< spread of refits under perturbed inputs
+  double msm_beta_std = 0;             ///< combined: sqrt(curvature^2 + input^2)
+  double spacing = 0;                  ///< median nearest-neighbour distance of the rest shape
+  double frame_interval_s = 0;         ///< mean time step used by the simulation
   double runtime_s = 0;
 };
 

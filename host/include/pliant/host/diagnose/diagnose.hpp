@@ -28,6 +28,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pliant/host/diagnose/diagnosis.hpp"
+#include "pliant/host/estimate.hpp"
 #include "pliant/host/recording.hpp"
 
 namespace pliant::host {
@@ -42,7 +43,14 @@ struct DiagnoseOptions {
   /// FEM: worker threads for the candidate fits (0: one per hardware thread, at most one per
   /// effect). The diagnosis does not depend on it.
   int threads = 0;
-  int holdout_block_frames = 0;  ///< 0: about a tenth of a second of frames (at least 3)
+  /// MSM: the baseline's msm_alpha and steps per frame, as `pliant estimate` chooses them
+  /// (docs/estimation.md): automatic selection, always fitted, or held at msm_alpha.
+  AlphaMode alpha = AlphaMode::automatic;
+  double msm_alpha = 1.0;              ///< (0, 1]: the held value
+  int steps_per_frame = 0;             ///< 0: chosen among 1..max_auto_steps_per_frame; else held (1..64)
+  bool cluster_radius_auto = true;     ///< also try auto_cluster_radii (else held)
+  double cluster_radius_factor = 1.5;  ///< held value, and the first the automatic choice tries
+  int holdout_block_frames = 0;        ///< 0: about a tenth of a second of frames (at least 3)
   /// Progress (stage name, done, total); may be empty.
   std::function<void(const std::string&, int, int)> progress;
 };

@@ -22,6 +22,12 @@ struct FittedModel {
   /// FEM with a measured wrench: held-out rms of the force residual (N); NaN otherwise (then
   /// absent from the JSON). `rms` is NaN (JSON null) when no free node position is compared.
   double force_rms = std::numeric_limits<double>::quiet_NaN();
+  /// MSM only (0 otherwise): the model form the baseline selection chose, which is not physics:
+  /// MSM steps per frame interval, msm_alpha fitted (else held), and why (one sentence).
+  int steps_per_frame = 0;
+  bool alpha_fitted = false;
+  double cluster_radius_factor = 0;  ///< cluster radius / median nearest-neighbour distance
+  std::string form_reason;
 };
 
 struct Candidate {
@@ -30,6 +36,9 @@ struct Candidate {
   std::map<std::string, double> parameter_std;
   double rms = 0;  ///< held-out rms
   double bic = 0;  ///< Bayesian information criterion on the fitting frames (lower is better)
+  /// MSM: share of the baseline's held-out misfit beyond the noise that the effect removes,
+  /// 1 - (rms^2 - noise^2) / (baseline rms^2 - noise^2); NaN (absent from the JSON) otherwise.
+  double explained = std::numeric_limits<double>::quiet_NaN();
   double force_rms = std::numeric_limits<double>::quiet_NaN();  ///< held-out force rms (N), FEM only
 };
 
@@ -57,6 +66,12 @@ struct Diagnosis {
   /// compared positions.
   double improvement = 0;
   std::vector<Candidate> candidates;  ///< best first
+  /// MSM: share of block-bootstrap resamples of the held-out frames in which the best passing
+  /// effect still improves the fit enough to be named (NaN when no effect passed).
+  double selection_stability = std::numeric_limits<double>::quiet_NaN();
+  /// An effect that fits almost as well as the named one (or wins on a fifth of the resamples);
+  /// empty when none. The explanation names the experiment that separates them.
+  std::string runner_up;
 };
 
 /// Per-frame, per-particle arrays for the report. A residual map is frame-major:

@@ -32,4 +32,14 @@ double residual_rms(const std::vector<double>& observed, const std::vector<doubl
                     int dimension, const std::vector<unsigned char>& frame_mask, unsigned char wanted,
                     const std::vector<unsigned char>* particle_mask = nullptr);
 
+/// An effect is named only when it explains at least this share of the baseline's held-out
+/// misfit beyond the noise (docs/diagnose.md, step 6).
+inline constexpr double min_explained_share = 0.75;
+
+/// Share of the baseline's held-out mean square beyond the noise that a fit removes:
+/// 1 - max(0, fit^2 - noise^2) / (baseline^2 - noise^2), all three rms in one unit (or all
+/// whitened, noise 1). 1 when the fit reaches the noise, 0 when it is no better than the
+/// baseline, negative when worse; 0 when the baseline is already within the noise.
+double explained_share(double baseline_rms, double fit_rms, double noise_rms);
+
 }  // namespace pliant::host

@@ -1,8 +1,9 @@
 // Free-running MSM simulation of a whole recording with every physics knob `diagnose` uses.
 //
-// The simulation starts at the model's rest shape and takes one MSM step per frame interval;
-// driven particles follow their observed positions inside their windows (holding the last
-// observed position through occlusions), everything else evolves under the model. The result
+// The simulation starts at the model's rest shape and takes `steps_per_frame` MSM steps per
+// frame interval; driven particles follow their observed positions inside their windows (holding
+// the last observed position through occlusions; within an interval the target moves linearly
+// from the previous frame's), everything else evolves under the model. The result
 // has the layout of Recording::positions (frame-major, [(frame * N + id) * dim + axis]) with a
 // value for every particle in every frame. Host code: allocates, throws std::runtime_error.
 #pragma once
@@ -20,6 +21,7 @@ namespace pliant::host {
 struct ModelSettings {
   double msm_beta = 0.5;
   double msm_alpha = 1.0;
+  int steps_per_frame = 1;            ///< MSM steps per frame interval, 1..max_steps_per_frame (core)
   std::vector<double> extra_gravity;  ///< undeclared body acceleration (empty: none), length_unit/s^2
   double velocity_damping = 0;        ///< 1/s
   double plastic_yield = 0;
@@ -37,7 +39,8 @@ struct ModelSettings {
 /// One recording prepared for repeated simulation (model, observations, support normal).
 class RecordingSimulator {
  public:
-  explicit RecordingSimulator(const Recording& recording);
+  /// `setup`: how the model is built (cluster radius, rest shape); the defaults are estimate's.
+  explicit RecordingSimulator(const Recording& recording, const MsmSetupOptions& setup = MsmSetupOptions{});
   ~RecordingSimulator();
   RecordingSimulator(const RecordingSimulator&) = delete;
   RecordingSimulator& operator=(const RecordingSimulator&) = delete;
