@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# The main job: install what is missing, build, estimate msm_beta on every bundled example, and
-# refine Young's modulus with the FEM on the three real silicone compression tests.
+# The main job: install what is missing, build, estimate msm_beta on every bundled example,
+# refine Young's modulus with the FEM on the three real silicone compression tests, and diagnose
+# two presses made by a simulator that is not ours (one with an effect, one without), writing
+# their HTML reports to build/diagnose/.
 # Usage: bash tools/demo.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -17,4 +19,10 @@ for recording in examples/phantom_compression/*/; do
   [ -f "${recording}recording.json" ] || continue
   echo
   build/bin/pliant refine "${recording%/}" --json "build/$(basename "$recording").material.json"
+done
+for recording in examples/diagnose/*/; do
+  [ -f "${recording}recording.json" ] || continue
+  name="$(basename "$recording")"
+  echo
+  build/bin/pliant diagnose "${recording%/}" -q --json "build/diagnose/${name}.json" --report "build/diagnose/${name}"
 done

@@ -125,9 +125,10 @@ std::string format_estimate_summary(const host::Recording& recording, const host
   text += format("rms         %.3g %s (mean error %.3g %s over %ld residuals)\n", r.rms, unit.c_str(), r.error,
                  unit.c_str(), r.residual_count);
   const int steps = report.baseline.steps_per_frame();
-  text += format("model       %d clusters, time step %.4g s, %d step%s per frame, rest from %d still frame%s\n",
-                 report.cluster_count, report.frame_interval_s / steps, steps, steps == 1 ? "" : "s",
-                 report.rest_frames, report.rest_frames == 1 ? "" : "s");
+  text += format(
+      "model       %d clusters of radius %.3g, time step %.4g s, %d step%s per frame, rest from %d still frame%s\n",
+      report.cluster_count, report.cluster_radius_factor, report.frame_interval_s / steps, steps, steps == 1 ? "" : "s",
+      report.rest_frames, report.rest_frames == 1 ? "" : "s");
   text += format("runtime     %.2f s (%d error evaluations)\n", report.runtime_s, r.evaluations);
   for (const std::string& warning : estimate_warnings(report)) text += "warning: " + warning + "\n";
   text += "\n" + format_error_curve(report, unit, 11);

@@ -1136,11 +1136,13 @@ std::string diagnosis_summary(const Diagnosis& d, const std::string& length_unit
   out << "\n  baseline msm_beta " << number(d.baseline.parameters.at("msm_beta")) << ", msm_alpha "
       << number(d.baseline.parameters.at("msm_alpha")) << (d.baseline.alpha_fitted ? " (fitted)" : " (held)") << ", "
       << d.baseline.steps_per_frame << (d.baseline.steps_per_frame == 1 ? " step" : " steps")
-      << " per frame, held-out rms " << number(d.baseline.rms) << " " << length_unit << ", noise "
-      << number(d.noise_rms) << " " << length_unit << "\n";
+      << " per frame, cluster radius " << number(d.baseline.cluster_radius_factor) << ", held-out rms "
+      << number(d.baseline.rms) << " " << length_unit << ", noise " << number(d.noise_rms) << " " << length_unit
+      << "\n";
   if (d.verdict == "missing_physics" && d.effect != "unknown") {
-    out << "  with " << d.effect << ": held-out rms " << number(d.augmented.rms) << " " << length_unit
-        << " (improvement " << number(100.0 * d.improvement) << " %)\n";
+    out << "  with " << d.effect << ": msm_beta " << number(d.augmented.parameters.at("msm_beta")) << ", held-out rms "
+        << number(d.augmented.rms) << " " << length_unit << " (improvement " << number(100.0 * d.improvement)
+        << " %)\n";
   }
   out << "  " << d.explanation << "\n";
   return out.str();
