@@ -19,6 +19,7 @@
 #include "pliant/host/diagnose/noise_floor.hpp"
 #include "pliant/host/diagnose/residual_field.hpp"
 #include "pliant/host/estimate.hpp"
+#include "pliant/host/parallel_fits.hpp"
 
 namespace pliant::host {
 namespace {
@@ -878,27 +879,52 @@ DiagnoseResult diagnose_recording(const Recording& recording, const DiagnoseOpti
                            options.cluster_radius_auto &&
                            (form.form.fit_alpha || form.form.steps_per_frame != 1 ||
                             form.form.cluster_radius_factor != plain.cluster_radius_factor);
+  MsmSetupOptions plain_setup;
+  plain_setup.clusters.radius_factor = plain.cluster_radius_factor;
   std::unique_ptr<RecordingSimulator> plain_simulator;
-  std::unique_ptr<Fitter> plain_fitter;
   Fit plain_baseline;
+  int plain_evaluations = 0;
   if (refit_plain) {
-    MsmSetupOptions plain_setup;
-    plain_setup.clusters.radius_factor = plain.cluster_radius_factor;
     plain_simulator = std::make_unique<RecordingSimulator>(recording, plain_setup);
-    plain_fitter = std::make_unique<Fitter>(*plain_simulator, scorer, context, plain);
-    plain_baseline = plain_fitter->fit_baseline();
+    Fitter plain_fitter(*plain_simulator, scorer, context, plain);
+    plain_baseline = plain_fitter.fit_baseline();
+    plain_evaluations = plain_fitter.evaluations;
   }
-  std::vector<Fit> fits;
-  for (std::size_t e = 0; e < effects.size(); ++e) {
-    report("effects", static_cast<int>(e), static_cast<int>(effects.size()));
-    fits.push_back(fitter.fit(&effects[e], baseline));
-    if (!refit_plain) continue;
-    Fit in_plain_form = plain_fitter->fit(&effects[e], plain_baseline);
-    if (in_plain_form.fit_residuals.squaredNorm() < fits.back().fit_residuals.squaredNorm()) {
-      fits.back() = std::move(in_plain_form);
-    }
-  }
-  report("effects", static_cast<int>(effects.size()), static_cast<int>(effects.size()));
+  // Every effect is fitted independently: on worker threads, each with its own simulators (a
+  // simulator holds its run state). The result does not depend on the thread count.
+  struct Worker {
+    std::unique_ptr<RecordingSimulator> simulator;  // null: the caller's
+    std::unique_ptr<RecordingSimulator> plain_simulator;
+    int evaluations = 0;
+  };
+  std::vector<Fit> fits(effects.size());
+  std::vector<int> effect_evaluations(effects.size(), 0);
+  int done = 0;
+  report("effects", 0, static_cast<int>(effects.size()));
+  run_on_workers(
+      effects.size(), worker_count(effects.size(), options.threads),
+      [&](bool is_caller) {
+        Worker worker;
+        if (!is_caller) worker.simulator = std::make_unique<RecordingSimulator>(recording, setup);
+        if (refit_plain) {
+          worker.plain_simulator =
+              is_caller ? std::move(plain_simulator) : std::make_unique<RecordingSimulator>(recording, plain_setup);
+        }
+        return worker;
+      },
+      [&](Worker& worker, std::size_t e) {
+        Fitter own(worker.simulator ? *worker.simulator : simulator, scorer, context, form.form);
+        fits[e] = own.fit(&effects[e], baseline);
+        effect_evaluations[e] = own.evaluations;
+        if (!refit_plain) return;
+        Fitter in_plain(*worker.plain_simulator, scorer, context, plain);
+        Fit in_plain_form = in_plain.fit(&effects[e], plain_baseline);
+        effect_evaluations[e] += in_plain.evaluations;
+        if (in_plain_form.fit_residuals.squaredNorm() < fits[e].fit_residuals.squaredNorm()) {
+          fits[e] = std::move(in_plain_form);
+        }
+      },
+      [&]() { report("effects", ++done, static_cast<int>(effects.size())); });
 
   // Every score counts the residuals as worth n / deff independent samples, deff the design
   // effect of the best-fitting model's residuals (the same for all, so that the scores compare).
@@ -1052,7 +1078,9 @@ DiagnoseResult diagnose_recording(const Recording& recording, const DiagnoseOpti
   ev.driven.erase(std::unique(ev.driven.begin(), ev.driven.end()), ev.driven.end());
   ev.signatures = signatures;
   ev.signatures["misfit_over_noise"] = misfit;
-  ev.signatures["simulations"] = fitter.evaluations + (plain_fitter ? plain_fitter->evaluations : 0);
+  int simulations = fitter.evaluations + plain_evaluations;
+  for (int count : effect_evaluations) simulations += count;
+  ev.signatures["simulations"] = simulations;
   ev.signatures["design_effect"] = deff;
   result.runtime_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;

@@ -22,6 +22,7 @@
 #include "pliant/host/diagnose/locate.hpp"
 #include "pliant/host/diagnose/model_run.hpp"
 #include "pliant/host/diagnose/noise_floor.hpp"
+#include "pliant/host/parallel_fits.hpp"
 #include "pliant/host/diagnose/residual_field.hpp"
 #include "pliant/host/fem/cylinder_mesh.hpp"
 #include "pliant/host/fem/least_squares_fit.hpp"
@@ -1071,46 +1072,25 @@ DiagnoseResult diagnose_recording_fem(const Recording& recording, const Diagnose
   std::vector<FemFit> fits(effects.size());
   std::vector<int> effect_simulations(effects.size(), 0);
   {
-    const unsigned hardware = std::max(1u, std::thread::hardware_concurrency());
-    const std::size_t workers = std::min<std::size_t>(
-        effects.size(), options.threads > 0 ? static_cast<std::size_t>(options.threads) : hardware);
-    std::atomic<std::size_t> next{0};
-    std::mutex mutex;  // guards done, failure and the progress callback
     int done = 0;
-    std::exception_ptr failure;
     report("effects", 0, static_cast<int>(effects.size()));
-    auto work = [&](FemRecordingSimulator* own) {
-      try {
-        std::unique_ptr<FemRecordingSimulator> made;
-        if (own == nullptr) {
-          made = make_simulator(mode);
-          made->set_fitting_frames(fitting_frames);
-          own = made.get();
-        }
-        for (std::size_t e = next++; e < effects.size(); e = next++) {
-          FemFitter fitter(*own, *scorer, context);
+    run_on_workers(
+        effects.size(), worker_count(effects.size(), options.threads),
+        [&](bool is_caller) {
+          std::unique_ptr<FemRecordingSimulator> made;
+          if (!is_caller) {
+            made = make_simulator(mode);
+            made->set_fitting_frames(fitting_frames);
+          }
+          return made;
+        },
+        [&](std::unique_ptr<FemRecordingSimulator>& made, std::size_t e) {
+          FemRecordingSimulator& own = made ? *made : *simulator;
+          FemFitter fitter(own, *scorer, context);
           fits[e] = fitter.fit(&effects[e], baseline.youngs);
           effect_simulations[e] = fitter.simulations;
-          const std::lock_guard<std::mutex> lock(mutex);
-          report("effects", ++done, static_cast<int>(effects.size()));
-        }
-      } catch (...) {
-        const std::lock_guard<std::mutex> lock(mutex);
-        if (!failure) failure = std::current_exception();
-        next = effects.size();
-      }
-    };
-    std::vector<std::thread> threads;
-    for (std::size_t w = 1; w < workers; ++w) {
-      try {
-        threads.emplace_back(work, nullptr);
-      } catch (const std::system_error&) {
-        break;  // no more threads to be had: the workers already started share the effects
-      }
-    }
-    work(simulator.get());
-    for (std::thread& thread : threads) thread.join();
-    if (failure) std::rethrow_exception(failure);
+        },
+        [&]() { report("effects", ++done, static_cast<int>(effects.size())); });
   }
   for (int count : effect_simulations) simulations += count;
 

@@ -11,6 +11,8 @@
 #include <vector>
 #include <stdexcept>
 
+#include "pliant/host/parallel_fits.hpp"
+
 namespace pliant::host {
 namespace {
 
@@ -251,19 +253,53 @@ MsmFit<Dim> fit_baseline(const Recording& recording, const EstimateOptions& opti
   };
 
   std::vector<MsmFit<Dim>> fits;
-  auto add = [&](int steps, bool fit_alpha, double radius) {
-    for (const BaselineCandidate& c : choice.candidates) {
-      if (c.steps_per_frame == steps && c.alpha_fitted == fit_alpha && c.cluster_radius_factor == radius) return;
+  struct Variant {
+    int steps;
+    bool fit_alpha;
+    double radius;
+  };
+  // Fits the variants not fitted yet, independently of each other on worker threads, then
+  // scores every variant so far. The order of the candidates is that of `wanted`.
+  auto add = [&](const std::vector<Variant>& wanted) {
+    std::vector<Variant> batch;
+    auto same = [](int steps, bool fit_alpha, double radius, const Variant& v) {
+      return steps == v.steps && fit_alpha == v.fit_alpha && radius == v.radius;
+    };
+    for (const Variant& v : wanted) {
+      bool fitted = false;
+      for (const BaselineCandidate& c : choice.candidates) {
+        fitted = fitted || same(c.steps_per_frame, c.alpha_fitted, c.cluster_radius_factor, v);
+      }
+      for (const Variant& b : batch) fitted = fitted || same(b.steps, b.fit_alpha, b.radius, v);
+      if (fitted) continue;
+      batch.push_back(v);
+      (void)model_for(v.radius);  // built here; the workers only read it
     }
-    fits.push_back(fit_msm<Dim>(recording, options, model_for(radius), steps, fit_alpha, options.msm_alpha, &progress));
-    ++progress.stage;
-    const DeformabilityResult& r = fits.back().result;
-    choice.candidates.push_back({steps, fit_alpha, r.msm_alpha, r.msm_beta, r.rms, 0.0, radius});
+    std::vector<MsmFit<Dim>> made(batch.size());
+    // One variant reports the progress of its run; several, a stage as each ends (so that the
+    // callback is never called from two threads at once).
+    StagedProgress* per_run = batch.size() == 1 ? &progress : nullptr;
+    run_on_workers(
+        batch.size(), worker_count(batch.size(), 0), [](bool) { return 0; },
+        [&](int&, std::size_t i) {
+          made[i] = fit_msm<Dim>(recording, options, model_for(batch[i].radius), batch[i].steps, batch[i].fit_alpha,
+                                 options.msm_alpha, per_run);
+        },
+        [&]() {
+          ++progress.stage;
+          if (per_run == nullptr && progress.callback != nullptr) StagedProgress::forward(&progress, 0, 1);
+        });
+    for (std::size_t i = 0; i < batch.size(); ++i) {
+      const DeformabilityResult& r = made[i].result;
+      choice.candidates.push_back(
+          {batch[i].steps, batch[i].fit_alpha, r.msm_alpha, r.msm_beta, r.rms, 0.0, batch[i].radius});
+      fits.push_back(std::move(made[i]));
+    }
     score_candidates<Dim>(fits, choice);
   };
   auto kept = [&]() { return choice.candidates[static_cast<std::size_t>(choice.chosen)]; };
 
-  add(first_steps, alpha_fit, setup_radius);
+  add({{first_steps, alpha_fit, setup_radius}});
   const bool choosing = alpha_auto || steps_auto || radius_auto;
   if (choosing && !alpha_fit && explained_by_noise(fits.front().result.rms, models.front().second->noise_std)) {
     char text[240];
@@ -276,14 +312,17 @@ MsmFit<Dim> fit_baseline(const Recording& recording, const EstimateOptions& opti
   } else {
     double radius = setup_radius;
     for (int round = 0; round < 3; ++round) {
+      std::vector<Variant> forms;
       for (int steps = first_steps; steps <= last_steps; ++steps) {
-        if (!alpha_fit) add(steps, false, radius);
-        if (alpha_auto || alpha_fit) add(steps, true, radius);
+        if (!alpha_fit) forms.push_back({steps, false, radius});
+        if (alpha_auto || alpha_fit) forms.push_back({steps, true, radius});
       }
+      add(forms);
       if (!radius_auto) break;
       const BaselineCandidate form = kept();
-      add(form.steps_per_frame, form.alpha_fitted, setup_radius);
-      for (double other : auto_cluster_radii) add(form.steps_per_frame, form.alpha_fitted, other);
+      std::vector<Variant> radii{{form.steps_per_frame, form.alpha_fitted, setup_radius}};
+      for (double other : auto_cluster_radii) radii.push_back({form.steps_per_frame, form.alpha_fitted, other});
+      add(radii);
       if (kept().cluster_radius_factor == radius) break;
       radius = kept().cluster_radius_factor;
     }

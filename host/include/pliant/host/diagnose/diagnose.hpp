@@ -40,8 +40,9 @@ struct DiagnoseOptions {
   std::string fem_time = "auto";
   /// FEM quasi-static only: solve every k-th frame (0: automatic, at most about 40 solved frames).
   int fem_frame_stride = 0;
-  /// FEM: worker threads for the candidate fits (0: one per hardware thread, at most one per
-  /// effect). The diagnosis does not depend on it.
+  /// Worker threads for the candidate fits, MSM and FEM (0: one per hardware thread, at most
+  /// one per effect). The diagnosis does not depend on it. (The MSM baseline's selection of
+  /// the model form runs its independent variants on one thread per hardware thread.)
   int threads = 0;
   /// MSM: the baseline's msm_alpha and steps per frame, as `pliant estimate` chooses them
   /// (docs/estimation.md): automatic selection, always fitted, or held at msm_alpha.
