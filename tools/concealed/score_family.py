@@ -25,7 +25,7 @@ import sys
 import tempfile
 import time
 
-EFFECTS = ["plasticity", "viscosity", "friction", "gravity", "heterogeneity", "stiffening", "none"]
+EFFECTS = ["plasticity", "viscosity", "friction", "gravity", "heterogeneity", "stiffening", "latency", "none"]
 COLUMNS = ["plasticity", "viscosity", "friction", "gravity", "heterogeneity", "stiffening", "latency",
            "unknown", "consistent", "error"]
 
@@ -128,7 +128,7 @@ def main():
     print(f"{'case':8} {'truth':13} {'scenario':11} {'size':>6} {'verdict':16} {'named':13} "
           f"{'improv':>7} {'base/noise':>10} {'s':>6}  ok")
     confusion = {e: {c: 0 for c in COLUMNS} for e in EFFECTS}
-    right = effect_cases = alarms = unknown_on_null = 0
+    right = effect_cases = alarms = unknown_on_null = wrong_names = 0
     improvements = []
     for case in cases:
         t, a = truths[case], answers[case]
@@ -149,6 +149,7 @@ def main():
             ok = named == truth
             mark = "yes" if ok else "NO"
             right += ok
+            wrong_names += not ok and named not in ("consistent", "unknown", "error")
             if a.get("improvement") is not None:
                 improvements.append(a["improvement"])
         verdict = a.get("verdict") or a.get("error", "")[:16]
@@ -170,6 +171,7 @@ def main():
     print(f"\neffect cases named right: {right}/{effect_cases}"
           f" ({100.0 * right / max(effect_cases, 1):.0f} %)")
     print(f"named false alarms on no-effect cases: {alarms}/{nulls} (unknown on no-effect: {unknown_on_null})")
+    print(f"wrong names on effect cases (an effect named that is not there): {wrong_names}")
     if improvements:
         print(f"mean held-out improvement on effect cases: {sum(improvements) / len(improvements):.3f}")
 
