@@ -386,6 +386,16 @@ class RealTimeAllocation : public ::testing::Test {
     ASSERT_EQ(deformability_workspace_init(arena, scene_.model, 1, config, owned.workspace), Status::ok);
   }
 
+  // estimate_deformability on the scene with default MSM parameters, the heap counted around it.
+  Status counted_estimate(const DeformabilityConfig& config, OwnedWorkspace& owned, DeformabilityResult& result,
+                          AllocationCounts& counts) const {
+    AllocationCounter counter;
+    const Status status = estimate_deformability(scene_.model, MsmParams<kFixtureDim, FixtureScalar>{},
+                                                 scene_.observations, config, owned.workspace, result);
+    counts = counter.stop();
+    return status;
+  }
+
   bool state_finite(const MsmState<kFixtureDim, FixtureScalar>& state) const {
     for (int i = 0; i < scene_.n; ++i) {
       if (!state.position[i].allFinite() || !state.velocity[i].allFinite()) return false;
@@ -718,7 +728,6 @@ TYPED_TEST(RealTimeAllocation, Tracker) {
 TYPED_TEST(RealTimeAllocation, EstimateTrajectory) {
   using Scalar = typename TestFixture::FixtureScalar;
   constexpr int Dim = TestFixture::kFixtureDim;
-  const auto& scene = this->scene_;
   DeformabilityConfig config;
   config.mode = FitMode::trajectory;
   int progress_calls = 0;
@@ -727,14 +736,8 @@ TYPED_TEST(RealTimeAllocation, EstimateTrajectory) {
   typename TestFixture::OwnedWorkspace owned;
   this->make_workspace(config, owned);
   DeformabilityResult result;
-  Status status = Status::not_initialized;
   AllocationCounts counts;
-  {
-    AllocationCounter counter;
-    status = estimate_deformability(scene.model, MsmParams<Dim, Scalar>{}, scene.observations, config, owned.workspace,
-                                    result);
-    counts = counter.stop();
-  }
+  const Status status = this->counted_estimate(config, owned, result, counts);
   EXPECT_NO_HEAP(counts, "estimate_deformability (trajectory)");
   ASSERT_EQ(status, Status::ok);
   EXPECT_GT(result.evaluations, config.grid_points);
@@ -744,22 +747,13 @@ TYPED_TEST(RealTimeAllocation, EstimateTrajectory) {
 }
 
 TYPED_TEST(RealTimeAllocation, EstimateFinalEquilibrium) {
-  using Scalar = typename TestFixture::FixtureScalar;
-  constexpr int Dim = TestFixture::kFixtureDim;
-  const auto& scene = this->scene_;
   DeformabilityConfig config;
   config.mode = FitMode::final_equilibrium;
   typename TestFixture::OwnedWorkspace owned;
   this->make_workspace(config, owned);
   DeformabilityResult result;
-  Status status = Status::not_initialized;
   AllocationCounts counts;
-  {
-    AllocationCounter counter;
-    status = estimate_deformability(scene.model, MsmParams<Dim, Scalar>{}, scene.observations, config, owned.workspace,
-                                    result);
-    counts = counter.stop();
-  }
+  const Status status = this->counted_estimate(config, owned, result, counts);
   EXPECT_NO_HEAP(counts, "estimate_deformability (final_equilibrium)");
   ASSERT_EQ(status, Status::ok);
   EXPECT_GT(result.evaluations, config.grid_points);
@@ -769,23 +763,14 @@ TYPED_TEST(RealTimeAllocation, EstimateFinalEquilibrium) {
 }
 
 TYPED_TEST(RealTimeAllocation, EstimateWithAlpha) {
-  using Scalar = typename TestFixture::FixtureScalar;
-  constexpr int Dim = TestFixture::kFixtureDim;
-  const auto& scene = this->scene_;
   DeformabilityConfig config;
   config.mode = FitMode::trajectory;
   config.estimate_alpha = true;
   typename TestFixture::OwnedWorkspace owned;
   this->make_workspace(config, owned);
   DeformabilityResult result;
-  Status status = Status::not_initialized;
   AllocationCounts counts;
-  {
-    AllocationCounter counter;
-    status = estimate_deformability(scene.model, MsmParams<Dim, Scalar>{}, scene.observations, config, owned.workspace,
-                                    result);
-    counts = counter.stop();
-  }
+  const Status status = this->counted_estimate(config, owned, result, counts);
   EXPECT_NO_HEAP(counts, "estimate_deformability (estimate_alpha)");
   ASSERT_EQ(status, Status::ok);
   EXPECT_GE(result.msm_alpha, config.alpha_min);
@@ -806,14 +791,8 @@ TYPED_TEST(RealTimeAllocation, EstimateWithStepsPerFrame) {
   typename TestFixture::OwnedWorkspace owned;
   this->make_workspace(config, owned);
   DeformabilityResult result;
-  Status status = Status::not_initialized;
   AllocationCounts counts;
-  {
-    AllocationCounter counter;
-    status = estimate_deformability(scene.model, MsmParams<Dim, Scalar>{}, scene.observations, config, owned.workspace,
-                                    result);
-    counts = counter.stop();
-  }
+  const Status status = this->counted_estimate(config, owned, result, counts);
   EXPECT_NO_HEAP(counts, "estimate_deformability (steps_per_frame 3)");
   ASSERT_EQ(status, Status::ok);
   EXPECT_GE(result.msm_beta, 0.0);
