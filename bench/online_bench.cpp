@@ -1,4 +1,7 @@
-// online_deformability_update: the per-frame cost of the online estimator (K = 11 candidates).
+// online_deformability_update: the per-frame cost of the online estimator (K = 11 candidates per
+// model form), with the form held (msm_alpha 1, one step per frame: 11 candidates), with the
+// default's three msm_alpha rows (33), and with replay's 3 alpha x 3 step rows (1, 2, 4 steps
+// per frame: 99 candidates, 231 MSM steps per update).
 //
 // Recordings (bench_support.hpp), all simulated with the core msm_step at msm_beta 0.5 with
 // deterministic noise: the paper's 2D foam press (4 x 8 particles, 121 frames at 30 Hz, px), the
@@ -8,8 +11,9 @@
 // the frame's observations; at the end of the recording the estimator is reset (untimed) and
 // the recording replays.
 //
-// Budget: <= 50 us per update on the 4 x 8 foam press, 2D and 3D, float and double. The 3D
-// block press (100 particles) is for information.
+// Budget: <= 50 us per update on the 4 x 8 foam press, 2D and 3D, float and double, with the form
+// held (the budget's original 11 candidates); <= 150 us with the default's three alpha rows.
+// The 3D block press (100 particles) and replay's nine forms are for information.
 #include <string>
 
 #include "bench_support.hpp"
@@ -20,6 +24,13 @@ namespace {
 
 constexpr int kCandidates = 11;
 
+// The model forms of one benchmark: msm_alpha rows x rows of steps per frame.
+struct Forms {
+  int alpha_rows = 1;
+  int step_rows = 1;
+  int msm_steps() const { return alpha_rows * ((1 << step_rows) - 1); }  // per msm_beta candidate
+};
+
 PressPlan plan_named(const std::string& name) {
   if (name == "foam_press") return foam_press_plan();
   if (name == "foam_press_3d") return foam_press_3d_plan();
@@ -27,7 +38,7 @@ PressPlan plan_named(const std::string& name) {
 }
 
 template <int Dim, typename Scalar>
-void BM_OnlineUpdate(benchmark::State& bench, const char* scene_name) {
+void BM_OnlineUpdate(benchmark::State& bench, const char* scene_name, Forms forms) {
   const PressPlan plan = plan_named(scene_name);
   const PressScene<Dim, Scalar>& scene = scene_for<Dim, Scalar>(plan, scene_name);
   if (scene.status != Status::ok) {
@@ -38,6 +49,8 @@ void BM_OnlineUpdate(benchmark::State& bench, const char* scene_name) {
   const PressRecording<Dim, Scalar>& recording = scene.recording;
   OnlineDeformabilityConfig config;
   config.candidates = kCandidates;
+  config.alpha_candidates = forms.alpha_rows;
+  config.step_candidates = forms.step_rows;
   std::vector<unsigned char> block(online_deformability_workspace_size(model, config));
   Arena arena(block.data(), block.size());
   OnlineDeformability<Dim, Scalar> estimator;
@@ -78,11 +91,12 @@ void BM_OnlineUpdate(benchmark::State& bench, const char* scene_name) {
   }
   if (!have_estimate) estimate = online_deformability_estimate(estimator);
   bench.counters["particles"] = model.particle_count;
-  bench.counters["candidates"] = kCandidates;
+  bench.counters["candidates"] = kCandidates * forms.alpha_rows * forms.step_rows;
   bench.counters["beta"] = estimate.msm_beta;
   bench.counters["beta_truth"] = plan.msm_beta;
+  bench.counters["alpha"] = estimate.msm_alpha;
   bench.counters["ns_per_particle_step"] =
-      stopwatch.per(static_cast<double>(bench.iterations()) * kCandidates * model.particle_count);
+      stopwatch.per(static_cast<double>(bench.iterations()) * kCandidates * forms.msm_steps() * model.particle_count);
 }
 
 // The estimate itself (O(K)), after a full recording.
@@ -123,16 +137,31 @@ void BM_OnlineEstimate(benchmark::State& bench, const char* scene_name) {
 }
 
 void register_all() {
-  auto add = [](const char* name, auto fn) { benchmark::RegisterBenchmark(name, fn)->Unit(benchmark::kMicrosecond); };
-  add("online_update/foam_press/2d/double", [](benchmark::State& s) { BM_OnlineUpdate<2, double>(s, "foam_press"); });
-  add("online_update/foam_press/2d/float", [](benchmark::State& s) { BM_OnlineUpdate<2, float>(s, "foam_press"); });
-  add("online_update/foam_press/3d/double",
-      [](benchmark::State& s) { BM_OnlineUpdate<3, double>(s, "foam_press_3d"); });
-  add("online_update/foam_press/3d/float", [](benchmark::State& s) { BM_OnlineUpdate<3, float>(s, "foam_press_3d"); });
-  add("online_update/block_press/3d/double", [](benchmark::State& s) { BM_OnlineUpdate<3, double>(s, "block_press"); });
-  add("online_update/block_press/3d/float", [](benchmark::State& s) { BM_OnlineUpdate<3, float>(s, "block_press"); });
+  auto add = [](const std::string& name, auto fn) {
+    benchmark::RegisterBenchmark(name.c_str(), fn)->Unit(benchmark::kMicrosecond);
+  };
+  const struct {
+    const char* suffix;
+    Forms forms;
+  } form_sets[] = {{"", Forms{1, 1}}, {"/alpha3", Forms{3, 1}}, {"/alpha3_steps3", Forms{3, 3}}};
+  for (const auto& set : form_sets) {
+    const Forms forms = set.forms;
+    const std::string s = set.suffix;
+    add("online_update/foam_press/2d/double" + s,
+        [forms](benchmark::State& st) { BM_OnlineUpdate<2, double>(st, "foam_press", forms); });
+    add("online_update/foam_press/2d/float" + s,
+        [forms](benchmark::State& st) { BM_OnlineUpdate<2, float>(st, "foam_press", forms); });
+    add("online_update/foam_press/3d/double" + s,
+        [forms](benchmark::State& st) { BM_OnlineUpdate<3, double>(st, "foam_press_3d", forms); });
+    add("online_update/foam_press/3d/float" + s,
+        [forms](benchmark::State& st) { BM_OnlineUpdate<3, float>(st, "foam_press_3d", forms); });
+    add("online_update/block_press/3d/double" + s,
+        [forms](benchmark::State& st) { BM_OnlineUpdate<3, double>(st, "block_press", forms); });
+    add("online_update/block_press/3d/float" + s,
+        [forms](benchmark::State& st) { BM_OnlineUpdate<3, float>(st, "block_press", forms); });
+  }
   add("online_estimate/foam_press/2d/double",
-      [](benchmark::State& s) { BM_OnlineEstimate<2, double>(s, "foam_press"); });
+      [](benchmark::State& st) { BM_OnlineEstimate<2, double>(st, "foam_press"); });
 }
 
 }  // namespace
@@ -141,10 +170,10 @@ void register_all() {
 int main(int argc, char** argv) {
   pliant::bench::register_all();
   const pliant::bench::Budgets budgets = {
-      {"online_update/foam_press/2d/double", 50.0},
-      {"online_update/foam_press/2d/float", 50.0},
-      {"online_update/foam_press/3d/double", 50.0},
-      {"online_update/foam_press/3d/float", 50.0},
+      {"online_update/foam_press/2d/double", 50.0},         {"online_update/foam_press/2d/float", 50.0},
+      {"online_update/foam_press/3d/double", 50.0},         {"online_update/foam_press/3d/float", 50.0},
+      {"online_update/foam_press/2d/double/alpha3", 150.0}, {"online_update/foam_press/2d/float/alpha3", 150.0},
+      {"online_update/foam_press/3d/double/alpha3", 150.0}, {"online_update/foam_press/3d/float/alpha3", 150.0},
   };
   return pliant::bench::run_benchmarks(argc, argv, budgets);
 }

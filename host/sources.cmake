@@ -12,6 +12,7 @@ set(PLIANT_RECORDING_SOURCES
 # MSM set-up from a recording and the msm_beta / msm_alpha estimate (msm_setup.hpp, estimate.hpp)
 set(PLIANT_ESTIMATION_SOURCES
   ${pliant_host_src}/estimation/msm_setup.cpp
+  ${pliant_host_src}/estimation/cluster_radii.cpp
   ${pliant_host_src}/estimation/estimate.cpp)
 # tetrahedral meshes and closed surfaces: readers, checks, TetGen, generated meshes (fem/mesh_io.hpp,
 # surface_io.hpp, tetrahedralize.hpp, mesh_vtk_series.hpp, cylinder_mesh.hpp, fem_box_mesh.hpp)

@@ -1,5 +1,6 @@
 #include "pliant/core/online_deformability.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -23,15 +24,24 @@ Status online_deformability_init(Arena& arena, const MsmModel<Dim, Scalar>& mode
   estimator = OnlineDeformability<Dim, Scalar>{};
   if (!model.initialized()) return Status::not_initialized;
   if (config.candidates < 3 || !(config.forgetting > 0) || config.forgetting > 1) return Status::invalid_argument;
+  if (config.alpha_candidates < 1 || config.alpha_candidates > kMaxOnlineAlphaRows) return Status::invalid_argument;
+  if (config.alpha_candidates > 1 && !(config.alpha_min > 0 && config.alpha_min < 1)) return Status::invalid_argument;
+  if (config.step_candidates < 1 || config.step_candidates > kMaxOnlineStepRows) return Status::invalid_argument;
   OnlineDeformability<Dim, Scalar> e;
   e.candidates = config.candidates;
+  e.alpha_candidates = config.alpha_candidates;
+  e.step_candidates = config.step_candidates;
+  e.alpha_min = config.alpha_candidates > 1 ? config.alpha_min : 1.0;
   e.params = base;
   e.forgetting = config.forgetting;
-  const auto k = static_cast<std::size_t>(config.candidates);
-  e.states = arena.carve<MsmState<Dim, Scalar>>(k);
-  e.sum_squares = arena.carve<double>(k);
+  const auto total = static_cast<std::size_t>(e.total_candidates());
+  e.states = arena.carve<MsmState<Dim, Scalar>>(total);
+  e.sum_squares = arena.carve<double>(total);
+  const auto n = static_cast<std::size_t>(model.particle_count);
+  e.step_start = arena.carve<Eigen::Matrix<Scalar, Dim, 1>>(n);
+  e.step_targets = arena.carve<Eigen::Matrix<Scalar, Dim, 1>>(n);
   bool ok = !arena.exhausted();
-  for (int c = 0; c < config.candidates; ++c) {
+  for (int c = 0; c < e.total_candidates(); ++c) {
     MsmState<Dim, Scalar> dummy;
     ok = msm_state_init(arena, model, e.states != nullptr ? e.states[c] : dummy) == Status::ok && ok;
   }
@@ -45,13 +55,51 @@ template <int Dim, typename Scalar>
 void online_deformability_reset(const MsmModel<Dim, Scalar>& model,
                                 OnlineDeformability<Dim, Scalar>& estimator) noexcept {
   PLIANT_ASSERT(estimator.initialized());
-  for (int c = 0; c < estimator.candidates; ++c) {
+  for (int c = 0; c < estimator.total_candidates(); ++c) {
     msm_state_reset(model, estimator.states[c]);
     estimator.sum_squares[c] = 0;
   }
   estimator.residual_count = 0;
   estimator.frames = 0;
 }
+
+namespace {
+
+// Advances one candidate over a frame interval of length dt: one MSM step straight to the driven
+// targets, or `steps` steps of dt / steps toward targets interpolated linearly from where each
+// driven particle was at the interval's start (its previous target, or its simulated position
+// when it was free). Returns the worst status of the steps.
+template <int Dim, typename Scalar>
+Status step_frame_interval(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>& params, Scalar dt,
+                           const MsmDrivenTargets<Dim, Scalar>& driven, int steps,
+                           OnlineDeformability<Dim, Scalar>& estimator, MsmState<Dim, Scalar>& state) noexcept {
+  MsmStepInput<Dim, Scalar> input;
+  if (steps == 1) {
+    input.dt = dt;
+    input.driven = driven;
+    return msm_step(model, params, input, state);
+  }
+  for (int c = 0; c < driven.count; ++c) {
+    const int id = driven.ids[c];
+    const bool known = id >= 0 && id < model.particle_count;
+    estimator.step_start[c] = known ? state.position[id] : driven.positions[c];
+  }
+  input.dt = dt / static_cast<Scalar>(steps);
+  input.driven = MsmDrivenTargets<Dim, Scalar>{driven.ids, estimator.step_targets, driven.count};
+  Status worst = Status::ok;
+  for (int j = 1; j <= steps; ++j) {
+    const Scalar share = static_cast<Scalar>(j) / static_cast<Scalar>(steps);
+    for (int c = 0; c < driven.count; ++c) {
+      estimator.step_targets[c] = estimator.step_start[c] + (driven.positions[c] - estimator.step_start[c]) * share;
+    }
+    const Status stepped = msm_step(model, params, input, state);
+    if (stepped != Status::ok && worst == Status::ok) worst = stepped;
+    if (stepped == Status::invalid_argument || stepped == Status::not_initialized) return stepped;
+  }
+  return worst;
+}
+
+}  // namespace
 
 template <int Dim, typename Scalar>
 Status online_deformability_update(const MsmModel<Dim, Scalar>& model, OnlineDeformability<Dim, Scalar>& estimator,
@@ -62,15 +110,18 @@ Status online_deformability_update(const MsmModel<Dim, Scalar>& model, OnlineDef
     ++estimator.rejected_frames;
     return Status::invalid_argument;
   }
+  if (driven.count < 0 || (estimator.step_candidates > 1 && driven.count > model.particle_count)) {
+    ++estimator.rejected_frames;
+    return Status::invalid_argument;
+  }
   MsmParams<Dim, Scalar> params = estimator.params;
-  MsmStepInput<Dim, Scalar> input;
-  input.dt = dt;
-  input.driven = driven;
   double frame_count = 0;
-  for (int c = 0; c < estimator.candidates; ++c) {
-    params.msm_beta = static_cast<Scalar>(static_cast<double>(c) / (estimator.candidates - 1));
+  const int k = estimator.candidates;
+  for (int c = 0; c < estimator.total_candidates(); ++c) {
+    params.msm_beta = static_cast<Scalar>(static_cast<double>(c % k) / (k - 1));
+    params.msm_alpha = static_cast<Scalar>(estimator.row_alpha(c / k));
     MsmState<Dim, Scalar>& state = estimator.states[c];
-    const Status stepped = msm_step(model, params, input, state);
+    const Status stepped = step_frame_interval(model, params, dt, driven, estimator.row_steps(c / k), estimator, state);
     if (stepped == Status::invalid_argument || stepped == Status::not_initialized) {
       ++estimator.rejected_frames;
       return Status::invalid_argument;
@@ -93,6 +144,84 @@ Status online_deformability_update(const MsmModel<Dim, Scalar>& model, OnlineDef
   return Status::ok;
 }
 
+namespace {
+
+// The least residual of one alpha row over msm_beta: the parabola through the best grid point
+// and its neighbours (the best grid point itself when the parabola is not convex).
+struct RowMinimum {
+  double msm_beta = 0;
+  double sum_squares = 0;
+  double curvature = 0;
+  int best = 0;
+};
+
+RowMinimum row_minimum(const double* sum_squares, int k) noexcept {
+  RowMinimum row;
+  for (int c = 1; c < k; ++c) {
+    if (sum_squares[c] < sum_squares[row.best]) row.best = c;
+  }
+  const double h = 1.0 / (k - 1);
+  const int centre = row.best == 0 ? 1 : (row.best == k - 1 ? k - 2 : row.best);
+  const ParabolaFit fit =
+      fit_parabola(centre * h, h, sum_squares[centre - 1], sum_squares[centre], sum_squares[centre + 1]);
+  row.curvature = fit.curvature;
+  const double vertex = fit.curvature > 0 ? fit.x : row.best * h;
+  row.msm_beta = vertex < 0 ? 0 : (vertex > 1 ? 1 : vertex);
+  row.sum_squares = fit.curvature > 0 ? std::max(fit.value, 0.0) : sum_squares[row.best];
+  return row;
+}
+
+// The fitted form: the row (msm_alpha, steps per frame) with the least residual. With three or
+// more alpha values, the parabola over alpha through that row and its neighbours of the same
+// step count refines alpha (kept inside the grid) and msm_beta is interpolated quadratically
+// between those rows. sum_squares stays the best row's own: the interpolated value is not a
+// simulated one, and comparing it with the held row would favour the fitted form.
+struct FittedForm {
+  double msm_alpha = 1;
+  double msm_beta = 0;
+  double sum_squares = 0;
+  int row = 0;
+};
+
+template <int Dim, typename Scalar>
+FittedForm fitted_form(const RowMinimum* rows, const OnlineDeformability<Dim, Scalar>& estimator) noexcept {
+  FittedForm form;
+  for (int r = 1; r < estimator.rows(); ++r) {
+    if (rows[r].sum_squares < rows[form.row].sum_squares) form.row = r;
+  }
+  form.msm_alpha = estimator.row_alpha(form.row);
+  form.msm_beta = rows[form.row].msm_beta;
+  form.sum_squares = rows[form.row].sum_squares;
+  const int count = estimator.alpha_candidates;
+  if (count < 3) return form;
+  const int group = form.row - form.row % count;
+  const int best = form.row % count;
+  const int centre = best == 0 ? 1 : (best == count - 1 ? count - 2 : best);
+  const RowMinimum& left = rows[group + centre - 1];
+  const RowMinimum& mid = rows[group + centre];
+  const RowMinimum& right = rows[group + centre + 1];
+  const double alpha_centre = estimator.row_alpha(group + centre);
+  const double h = estimator.row_alpha(group + 1) - estimator.row_alpha(group);
+  const ParabolaFit fit = fit_parabola(alpha_centre, h, left.sum_squares, mid.sum_squares, right.sum_squares);
+  if (!(fit.curvature > 0)) return form;
+  const double alpha = std::min(std::max(fit.x, estimator.row_alpha(group)), 1.0);
+  const double t = (alpha - alpha_centre) / h;
+  const double beta = mid.msm_beta + 0.5 * t * (right.msm_beta - left.msm_beta) +
+                      0.5 * t * t * (right.msm_beta - 2 * mid.msm_beta + left.msm_beta);
+  form.msm_alpha = alpha;
+  form.msm_beta = beta < 0 ? 0 : (beta > 1 ? 1 : beta);
+  return form;
+}
+
+// BIC with `extra` more parameters: n ln(S_held / S_fitted) > extra ln n.
+bool form_determined(double held, double fitted, double points, int extra) noexcept {
+  if (!(points > 1) || !(held > fitted)) return false;
+  if (!(fitted > 0)) return true;
+  return points * std::log(held / fitted) > extra * std::log(points);
+}
+
+}  // namespace
+
 template <int Dim, typename Scalar>
 OnlineDeformabilityEstimate online_deformability_estimate(const OnlineDeformability<Dim, Scalar>& estimator) noexcept {
   OnlineDeformabilityEstimate out;
@@ -100,20 +229,28 @@ OnlineDeformabilityEstimate online_deformability_estimate(const OnlineDeformabil
   out.msm_beta_std = std::numeric_limits<double>::infinity();
   if (!estimator.initialized() || estimator.residual_count < 2) return out;
   const int k = estimator.candidates;
-  int best = 0;
-  for (int c = 1; c < k; ++c) {
-    if (estimator.sum_squares[c] < estimator.sum_squares[best]) best = c;
+  RowMinimum rows[kMaxOnlineAlphaRows * kMaxOnlineStepRows];
+  for (int r = 0; r < estimator.rows(); ++r) rows[r] = row_minimum(estimator.sum_squares + r * k, k);
+  const int held = estimator.alpha_candidates - 1;  // alpha 1 (or the base alpha), one step per frame
+  const FittedForm fitted = fitted_form(rows, estimator);
+  const int extra = (estimator.alpha_candidates > 1 ? 1 : 0) + (estimator.step_candidates > 1 ? 1 : 0);
+  out.alpha_fitted =
+      extra > 0 && form_determined(rows[held].sum_squares, fitted.sum_squares, estimator.residual_count / Dim, extra);
+  const int answering = out.alpha_fitted ? fitted.row : held;
+  const RowMinimum& row = rows[answering];
+  out.msm_beta = out.alpha_fitted ? fitted.msm_beta : row.msm_beta;
+  out.msm_alpha = out.alpha_fitted ? fitted.msm_alpha : estimator.row_alpha(held);
+  out.steps_per_frame = estimator.row_steps(answering);
+  out.msm_beta_std = least_squares_std(row.sum_squares, row.curvature, static_cast<long>(estimator.residual_count));
+  if (out.alpha_fitted) {
+    // The form was chosen by a criterion that counts every residual as independent; where the
+    // forms disagree on msm_beta, the interval spans the held form's answer too.
+    const double disagreement = out.msm_beta - rows[held].msm_beta;
+    out.msm_beta_std = std::sqrt(out.msm_beta_std * out.msm_beta_std + disagreement * disagreement);
   }
-  const double h = 1.0 / (k - 1);
-  const int centre = best == 0 ? 1 : (best == k - 1 ? k - 2 : best);
-  const ParabolaFit fit = fit_parabola(centre * h, h, estimator.sum_squares[centre - 1], estimator.sum_squares[centre],
-                                       estimator.sum_squares[centre + 1]);
-  const double vertex = fit.curvature > 0 ? fit.x : best * h;
-  out.msm_beta = vertex < 0 ? 0 : (vertex > 1 ? 1 : vertex);
-  const double s_min = fit.curvature > 0 ? std::max(fit.value, 0.0) : estimator.sum_squares[best];
-  out.msm_beta_std = least_squares_std(s_min, fit.curvature, static_cast<long>(estimator.residual_count));
-  out.unique_minimum = fit.curvature > 0 && single_basin(estimator.sum_squares, k);
-  out.rms = std::sqrt(estimator.sum_squares[best] / estimator.residual_count);
+  const double* row_squares = estimator.sum_squares + answering * k;
+  out.unique_minimum = row.curvature > 0 && single_basin(row_squares, k);
+  out.rms = std::sqrt(row_squares[row.best] / estimator.residual_count);
   return out;
 }
 

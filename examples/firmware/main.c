@@ -97,6 +97,10 @@ static void setup(void) {
   config.guard.squeeze_axis[0] = 1.0;
   config.guard.max_width_m = 0.1;
   config.guard.exceeded_stop_action = PLIANT_STOP_OPEN;
+  /* One model form for the online estimate: the default's three msm_alpha rows triple the
+   * estimator's candidate states, more than this 512 KB part leaves beside the rest. The form
+   * (config.msm.msm_alpha, cluster radius) is the one `pliant estimate` chose offline. */
+  config.estimator.alpha_candidates = 1;
 
   size_t need = 0U;
   require(pliant_workspace_size(&config, &need));

@@ -31,19 +31,23 @@
  *     layouts do not depend on the compiler's enum size.
  *   - Arrays of per-particle values are particle-major: element (i, axis) at [i * dim + axis].
  *
- * FOOTPRINT AND TIMING (N particles, C clusters, K estimator candidates)
- *   The block holds the object model twice (the tracker's and the guard's), the tracker, K MSM
- *   states for the estimator (the largest part), the guard's prediction table and its init-time
- *   simulation, and per-frame buffers: O(K (N + C) + memberships) bytes. Measured with the
- *   defaults (x86-64): a 4x4x3 block (N = 48) needs 407 KB computing in double, 214 KB in
- *   float; an 8x4 2D sheet 164 KB / 92 KB. Without the estimator less than half of that.
+ * FOOTPRINT AND TIMING (N particles, C clusters, K estimator candidates per form, A x S forms)
+ *   The block holds the object model twice (the tracker's and the guard's), the tracker, A x S x K
+ *   MSM states for the estimator (the largest part), the guard's prediction table and its init-time
+ *   simulation, and per-frame buffers: O(A S K (N + C) + memberships) bytes. Measured with the
+ *   defaults (x86-64, A = 3, S = 1): a 4x4x3 block (N = 48) needs 893 KB computing in double;
+ *   an 8x4 2D sheet 351 KB (with A = 1: 407 KB and 164 KB in double, 214 KB and 92 KB in
+ *   float). Without the estimator a fifth of that.
  *   Ask pliant_workspace_size for your object.
  *   pliant_init is SLOW: it builds the models (O(N^2)) and the guard's prediction table
  *   (prediction_beta_points x (prediction_closure_points + prediction_refine_steps) quasi-static
  *   MSM relaxations of up to relax_max_iterations steps each): 25 ms for N = 48 on a desktop
  *   core, expect tens of times longer on a Cortex-M7. Call it before the control loop.
  *   Real-time calls, N = 48, desktop core, double: pliant_push_observations +
- *   pliant_step_tracker about 30 us; pliant_update_estimate about 60 us (K = 11 MSM steps);
+ *   pliant_step_tracker about 30 us; pliant_update_estimate about 60 us per row of K = 11
+ *   candidates, A (2^S - 1) rows' worth (bench/online_bench, the core update alone, 32
+ *   particles in double: 16 us for one row and 50 us for the default three in 2D, 63 and
+ *   227 us in 3D);
  *   pliant_guard_update about 0.3 us, O(prediction_beta_points). None allocates, blocks or
  *   loops without bound.
  *
@@ -136,7 +140,7 @@ extern "C" {
 
 /** Bumped whenever any struct or enumeration value of this header changes. A firmware
  *  compiled against a header with another ABI version is refused (PLIANT_ERROR_ABI_MISMATCH). */
-#define PLIANT_ABI_VERSION 1U
+#define PLIANT_ABI_VERSION 2U
 
 /** The library's version, packed as PLIANT_VERSION_NUMBER. Compare it with the header's
  *  PLIANT_VERSION_NUMBER to detect a stale library. Constant time, real-time safe. */
@@ -237,8 +241,14 @@ typedef struct pliant_tracker_config_s {
 
 typedef struct pliant_estimator_config_s {
   bool enabled;       /**< default true; false: no estimator memory, update_estimate refused */
-  int32_t candidates; /**< K >= 3 msm_beta candidates on [0, 1], default 11 */
-  double forgetting;  /**< (0, 1] per-frame weight of past residuals, default 1 */
+  int32_t candidates; /**< K >= 3 msm_beta candidates on [0, 1] per model form, default 11 */
+  /** A in [1, 8] msm_alpha rows, uniform on [alpha_min, 1]; default 3. 1: the msm config's
+   *  alpha is held. The form other than (alpha 1, one step) answers only when the frames
+   *  determine it (BIC); see pliant_estimate_t.form_fitted. */
+  int32_t alpha_candidates;
+  double alpha_min;        /**< (0, 1), lowest msm_alpha row when A >= 2, default 0.3 */
+  int32_t step_candidates; /**< S in [1, 4]: rows at 1, 2, .., 2^(S-1) MSM steps per frame; default 1 */
+  double forgetting;       /**< (0, 1] per-frame weight of past residuals, default 1 */
   /** true (default): after each estimate whose sd is finite and <= feed_back_max_std, the
    *  tracker's prior msm_beta is set to the estimate. */
   bool feed_back_beta;
@@ -499,15 +509,18 @@ typedef struct pliant_verdict_s {
 #define PLIANT_TRACK_LOST 2U      /**< no usable observation for > max_unobserved_frames */
 
 typedef struct pliant_estimate_s {
-  double stamp_s;          /**< stamp of the last frame the estimator used; NaN before */
-  double msm_beta;         /**< [0, 1] */
-  double msm_beta_std;     /**< +inf until the residual curve has a positive curvature */
-  double rms;              /**< rms residual of the best candidate, m */
-  uint32_t frames;         /**< frames the estimator used since init / reset */
-  bool unique_minimum;     /**< the residual curve has one basin */
-  bool valid;              /**< frames > 0 and msm_beta_std finite */
-  bool fed_back;           /**< this estimate was fed to the tracker's prior */
-  double tracker_msm_beta; /**< the tracker's current prior msm_beta */
+  double stamp_s;           /**< stamp of the last frame the estimator used; NaN before */
+  double msm_beta;          /**< [0, 1] */
+  double msm_beta_std;      /**< +inf until the residual curve has a positive curvature */
+  double rms;               /**< rms residual of the best candidate, m */
+  double msm_alpha;         /**< msm_alpha of the answering model form */
+  uint32_t steps_per_frame; /**< MSM steps per frame of the answering model form */
+  bool form_fitted;         /**< true: the frames determined a form other than alpha 1, one step */
+  uint32_t frames;          /**< frames the estimator used since init / reset */
+  bool unique_minimum;      /**< the residual curve has one basin */
+  bool valid;               /**< frames > 0 and msm_beta_std finite */
+  bool fed_back;            /**< this estimate was fed to the tracker's prior */
+  double tracker_msm_beta;  /**< the tracker's current prior msm_beta */
 } pliant_estimate_t;
 
 typedef struct pliant_deformation_s {
@@ -690,10 +703,11 @@ pliant_status_t pliant_get_tracked(pliant_t* instance, float* positions, uint8_t
  *  estimator is counted (estimator_frames_skipped) and its time is added to the next
  *  estimator step. With feed_back_beta, a confident estimate becomes the tracker's prior.
  *  Returns OK, NO_OBSERVATIONS (stepped, nothing scored; counted), or errors: NULL_ARGUMENT,
- *  NOT_INITIALIZED, DISABLED, BAD_STATE (no new stepped frame). Real-time safe, K MSM steps. */
+ *  NOT_INITIALIZED, DISABLED, BAD_STATE (no new stepped frame). Real-time safe,
+ *  K x A x (2^S - 1) MSM steps. */
 pliant_status_t pliant_update_estimate(pliant_t* instance);
 
-/** The current estimate. Errors: NULL_ARGUMENT, NOT_INITIALIZED, DISABLED. Real-time, O(K). */
+/** The current estimate. Errors: NULL_ARGUMENT, NOT_INITIALIZED, DISABLED. Real-time, O(K A S). */
 pliant_status_t pliant_get_estimate(pliant_t* instance, pliant_estimate_t* out);
 
 /** The strain measured on the last stepped frame (what PLIANT_SOURCE_BRIDGE gives the guard).

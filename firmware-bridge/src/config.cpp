@@ -37,6 +37,9 @@ void default_estimator(pliant_estimator_config_t& out) noexcept {
   const OnlineDeformabilityConfig core;
   out.enabled = true;
   out.candidates = core.candidates;
+  out.alpha_candidates = core.alpha_candidates;
+  out.alpha_min = core.alpha_min;
+  out.step_candidates = core.step_candidates;
   out.forgetting = core.forgetting;
   out.feed_back_beta = true;
   out.feed_back_max_std = 0.1;
@@ -146,8 +149,11 @@ pliant_status_t validate_tracker(const pliant_tracker_config_t& t) noexcept {
 
 pliant_status_t validate_estimator(const pliant_estimator_config_t& e) noexcept {
   if (!e.enabled) return PLIANT_OK;
-  const bool ok = e.candidates >= 3 && e.candidates <= kMaxCandidates && e.forgetting > 0 && e.forgetting <= 1 &&
-                  !std::isnan(e.feed_back_max_std) && e.feed_back_max_std >= 0;
+  const bool rows_ok = e.alpha_candidates >= 1 && e.alpha_candidates <= kMaxOnlineAlphaRows && e.step_candidates >= 1 &&
+                       e.step_candidates <= kMaxOnlineStepRows &&
+                       (e.alpha_candidates == 1 || (e.alpha_min > 0 && e.alpha_min < 1));
+  const bool ok = rows_ok && e.candidates >= 3 && e.candidates <= kMaxCandidates && e.forgetting > 0 &&
+                  e.forgetting <= 1 && !std::isnan(e.feed_back_max_std) && e.feed_back_max_std >= 0;
   return ok ? PLIANT_OK : PLIANT_ERROR_INVALID_ARGUMENT;
 }
 
@@ -253,6 +259,9 @@ TrackerConfig to_core(const pliant_tracker_config_t& tracker) noexcept {
 OnlineDeformabilityConfig to_core(const pliant_estimator_config_t& estimator) noexcept {
   OnlineDeformabilityConfig out;
   out.candidates = estimator.candidates;
+  out.alpha_candidates = estimator.alpha_candidates;
+  out.alpha_min = estimator.alpha_min;
+  out.step_candidates = estimator.step_candidates;
   out.forgetting = estimator.forgetting;
   return out;
 }

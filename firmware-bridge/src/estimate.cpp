@@ -51,6 +51,9 @@ pliant_status_t pliant_get_estimate(pliant_t* instance, pliant_estimate_t* out) 
   e.msm_beta = c.estimate.msm_beta;
   e.msm_beta_std = c.estimate.msm_beta_std;
   e.rms = c.estimate.rms;
+  e.msm_alpha = c.estimate.msm_alpha;
+  e.steps_per_frame = static_cast<std::uint32_t>(c.estimate.steps_per_frame);
+  e.form_fitted = c.estimate.alpha_fitted;
   e.frames = c.estimate.frames;
   e.unique_minimum = c.estimate.unique_minimum;
   e.valid = c.estimate.frames > 0 && is_finite(c.estimate.msm_beta_std);

@@ -42,6 +42,9 @@ nlohmann::json event_json(const host::ReplayEvent& e) {
     if (e.estimate != nullptr) {
       j["estimate"] = {{"msm_beta", number(e.estimate->msm_beta)},
                        {"msm_beta_std", number(e.estimate->msm_beta_std)},
+                       {"msm_alpha", number(e.estimate->msm_alpha)},
+                       {"alpha_fitted", e.estimate->alpha_fitted},
+                       {"steps_per_frame", e.estimate->steps_per_frame},
                        {"rms", number(e.estimate->rms)},
                        {"frames", e.estimate->frames},
                        {"update", status_name(e.estimator_status)}};
@@ -81,6 +84,9 @@ nlohmann::json summary_json(const host::ReplaySummary& s) {
   if (s.estimated) {
     j["summary"]["estimate"] = {{"msm_beta", number(s.estimate.msm_beta)},
                                 {"msm_beta_std", number(s.estimate.msm_beta_std)},
+                                {"msm_alpha", number(s.estimate.msm_alpha)},
+                                {"alpha_fitted", s.estimate.alpha_fitted},
+                                {"steps_per_frame", s.estimate.steps_per_frame},
                                 {"unique_minimum", s.estimate.unique_minimum},
                                 {"rms", number(s.estimate.rms)},
                                 {"frames", s.estimate.frames},
@@ -107,7 +113,10 @@ ReplayCommand::ReplayCommand(CLI::App& parent) {
       "sensor and a gripper (the HAL replay mocks), in real time (--speed scales it) or --stepped (as fast as "
       "possible, in recorded order, reproducible), optionally with the faults of a fault script (docs/hal.md; "
       "devices observer, ft, gripper; times from the start of the replay). Estimates msm_beta online from the "
-      "delivered frames as a controller would. Writes one JSON object per delivered sample or device failure to "
+      "delivered frames as a controller would: 21 msm_beta candidates for each model form (msm_alpha 0.3, 0.65 "
+      "or 1 at 1, 2 or 4 MSM steps per frame), the form other than alpha 1 at one step taken only when the frames "
+      "determine it (BIC; --msm-alpha holds alpha at one step per frame). Writes one JSON object per delivered sample "
+      "or device failure to "
       "standard output or -o FILE, the last line a summary; prints the summary on standard error. Ctrl-C stops "
       "early and still writes the summary.");
   app_->add_option("recording", recording_, "recording directory")->required();
@@ -115,6 +124,8 @@ ReplayCommand::ReplayCommand(CLI::App& parent) {
   app_->add_option("--speed", speed_, "recorded seconds per real second (default 1)")->check(CLI::PositiveNumber);
   app_->add_option("--faults", faults_, "fault script file");
   app_->add_flag("--no-estimate", no_estimate_, "do not run the online msm_beta estimate");
+  app_->add_option("--msm-alpha", msm_alpha_, "hold msm_alpha at this value in (0, 1] (default: chosen online)")
+      ->check(CLI::Range(1e-6, 1.0));
   app_->add_option("-o,--output", output_, "JSON lines file (written when the replay ends)");
 }
 
@@ -124,6 +135,11 @@ int ReplayCommand::run() const {
   options.timing.mode = stepped_ ? hal::ReplayMode::stepped : hal::ReplayMode::realtime;
   options.timing.speed = speed_;
   options.estimate = !no_estimate_;
+  if (msm_alpha_) {
+    options.msm_alpha = *msm_alpha_;
+    options.alpha_candidates = 1;
+    options.step_candidates = 1;
+  }
   if (!faults_.empty()) options.fault_script = read_text_file(faults_);
 
   std::ostringstream buffered;

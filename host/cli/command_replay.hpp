@@ -1,10 +1,12 @@
-// `pliant replay REC [--stepped | --speed S] [--faults SCRIPT] [--no-estimate] [-o OUT.jsonl]`:
+// `pliant replay REC [--stepped | --speed S] [--faults SCRIPT] [--no-estimate] [--msm-alpha A]
+//                    [-o OUT.jsonl]`:
 // plays a recording back through the HAL replay devices (particle observer, force/torque
 // sensor, gripper), optionally with scripted faults, and estimates msm_beta online from what
 // the observer delivers (pliant/host/replay/replay_session.hpp). Writes one JSON object per
 // delivered sample or device failure, and prints a summary of every device's counters.
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -27,6 +29,7 @@ class ReplayCommand {
   double speed_ = 1.0;
   std::string faults_;
   bool no_estimate_ = false;
+  std::optional<double> msm_alpha_;
   std::string output_;
 };
 

@@ -50,6 +50,9 @@ TEST(BridgeDefaults, AreTheCoresDefaults) {
   EXPECT_TRUE(c.estimator.enabled);
   EXPECT_EQ(c.estimator.candidates, estimator.candidates);
   EXPECT_EQ(c.estimator.forgetting, estimator.forgetting);
+  EXPECT_EQ(c.estimator.alpha_candidates, estimator.alpha_candidates);
+  EXPECT_EQ(c.estimator.alpha_min, estimator.alpha_min);
+  EXPECT_EQ(c.estimator.step_candidates, estimator.step_candidates);
   EXPECT_TRUE(c.estimator.feed_back_beta);
 
   const GraspGuardConfig g;

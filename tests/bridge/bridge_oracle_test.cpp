@@ -337,6 +337,9 @@ TYPED_TEST(BridgeOracle, AgreesWithTheCoreAndFindsTheBeta) {
     EXPECT_TRUE(same(estimate.msm_beta, core.estimate.msm_beta)) << f;
     EXPECT_TRUE(same(estimate.msm_beta_std, core.estimate.msm_beta_std)) << f;
     EXPECT_TRUE(same(estimate.rms, core.estimate.rms)) << f;
+    EXPECT_TRUE(same(estimate.msm_alpha, core.estimate.msm_alpha)) << f;
+    EXPECT_EQ(estimate.steps_per_frame, static_cast<std::uint32_t>(core.estimate.steps_per_frame));
+    EXPECT_EQ(estimate.form_fitted, core.estimate.alpha_fitted);
     EXPECT_EQ(estimate.frames, core.estimate.frames);
     EXPECT_EQ(estimate.tracker_msm_beta, static_cast<double>(core.tracker.params.msm_beta));
 

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "press_observations.hpp"
 
 namespace {
@@ -44,6 +46,58 @@ TEST(OnlineDeformability, ConvergesToTheTruthDuringThePress) {
   }
 }
 
+pliant::OnlineDeformabilityConfig held_form() {
+  pliant::OnlineDeformabilityConfig config;
+  config.alpha_candidates = 1;
+  config.step_candidates = 1;
+  return config;
+}
+
+pliant::OnlineDeformabilityConfig alpha_and_step_rows() {
+  pliant::OnlineDeformabilityConfig config;
+  config.step_candidates = 3;
+  return config;
+}
+
+TEST(OnlineDeformability, ChoosesMsmAlphaWhenThePressDeterminesIt) {
+  for (double beta : {0.25, 0.6}) {
+    pliant::test::PressExperiment<2, double> experiment(beta, 0.5, 0.5, 5);
+    const auto fitted = run_online(experiment, pliant::OnlineDeformabilityConfig{});
+    const auto held = run_online(experiment, held_form());
+    EXPECT_TRUE(fitted.alpha_fitted) << beta;
+    // alpha is a nuisance here, read off a grid 0.35 apart: under-relaxed is what matters.
+    EXPECT_LT(fitted.msm_alpha, 0.85) << beta;
+    EXPECT_EQ(fitted.steps_per_frame, 1);
+    EXPECT_NEAR(fitted.msm_beta, beta, 0.03) << beta;
+    EXPECT_LT(fitted.rms, held.rms) << beta;
+    // The interval of a fitted form spans the held form's answer.
+    EXPECT_GE(fitted.msm_beta_std, std::abs(fitted.msm_beta - held.msm_beta)) << beta;
+    EXPECT_FALSE(held.alpha_fitted);
+    EXPECT_EQ(held.msm_alpha, 1.0);
+  }
+}
+
+TEST(OnlineDeformability, HoldsAlphaOneWhenItFits) {
+  pliant::test::PressExperiment<2, double> experiment(0.45, 1.0, 0.5, 9);
+  const auto estimate = run_online(experiment, alpha_and_step_rows());
+  EXPECT_FALSE(estimate.alpha_fitted);
+  EXPECT_EQ(estimate.msm_alpha, 1.0);
+  EXPECT_EQ(estimate.steps_per_frame, 1);
+  EXPECT_NEAR(estimate.msm_beta, 0.45, 0.03);
+}
+
+TEST(OnlineDeformability, FindsSeveralStepsPerFrame) {
+  pliant::test::PressExperiment<2, double> experiment(0.35, 0.65, 0.5, 11, 8, 4, 3, 100.0, 60.0, 4.0, 30.0, HUGE_VAL,
+                                                      2);
+  const auto held = run_online(experiment, held_form());
+  const auto fitted = run_online(experiment, alpha_and_step_rows());
+  EXPECT_TRUE(fitted.alpha_fitted);
+  EXPECT_EQ(fitted.steps_per_frame, 2);
+  EXPECT_LT(fitted.msm_alpha, 0.9);
+  EXPECT_NEAR(fitted.msm_beta, 0.35, 0.03);
+  EXPECT_GT(std::abs(held.msm_beta - 0.35), std::abs(fitted.msm_beta - 0.35));
+}
+
 TEST(OnlineDeformability, ThreeDimensionalFloat) {
   pliant::test::PressExperiment<3, float> experiment(0.35, 1.0, 0.0, 1, 5, 4, 3, 0.01, 0.004, 3.0);
   const auto estimate = run_online(experiment, pliant::OnlineDeformabilityConfig{});
@@ -70,10 +124,22 @@ TEST(OnlineDeformability, NoEvidenceMeansNoConfidence) {
   EXPECT_EQ(pliant::online_deformability_update(f.model, online, std::nan(""), none, hidden.data()),
             Status::invalid_argument);
   EXPECT_EQ(online.rejected_frames, 1u);
-  pliant::OnlineDeformabilityConfig bad;
-  bad.candidates = 2;
-  EXPECT_EQ(pliant::online_deformability_init(arena, f.model, pliant::MsmParams<2, double>{}, bad, online),
-            Status::invalid_argument);
+  auto refused = [&](void (*spoil)(pliant::OnlineDeformabilityConfig&)) {
+    pliant::OnlineDeformabilityConfig bad;
+    spoil(bad);
+    return pliant::online_deformability_init(arena, f.model, pliant::MsmParams<2, double>{}, bad, online) ==
+           Status::invalid_argument;
+  };
+  EXPECT_TRUE(refused([](pliant::OnlineDeformabilityConfig& c) { c.candidates = 2; }));
+  EXPECT_TRUE(refused([](pliant::OnlineDeformabilityConfig& c) { c.alpha_candidates = 0; }));
+  EXPECT_TRUE(
+      refused([](pliant::OnlineDeformabilityConfig& c) { c.alpha_candidates = pliant::kMaxOnlineAlphaRows + 1; }));
+  EXPECT_TRUE(refused([](pliant::OnlineDeformabilityConfig& c) { c.alpha_min = 0; }));
+  EXPECT_TRUE(refused([](pliant::OnlineDeformabilityConfig& c) { c.alpha_min = 1; }));
+  EXPECT_TRUE(refused([](pliant::OnlineDeformabilityConfig& c) { c.step_candidates = 0; }));
+  EXPECT_TRUE(
+      refused([](pliant::OnlineDeformabilityConfig& c) { c.step_candidates = pliant::kMaxOnlineStepRows + 1; }));
+  EXPECT_TRUE(refused([](pliant::OnlineDeformabilityConfig& c) { c.forgetting = 0; }));
 }
 
 }  // namespace

@@ -11,7 +11,8 @@
 namespace pliant::test {
 
 /// Lattice nx x ny (x nz), bottom layer fixed, the top particle near the middle driven down by
-/// `depth` over 1 s and held until `duration_s`, at `rate_hz`. Observations get Gaussian noise.
+/// `depth` over 1 s and held until `duration_s`, at `rate_hz`, with `steps_per_frame` MSM steps
+/// per frame interval (the tool's target moving on between them). Observations get Gaussian noise.
 template <int Dim, typename Scalar>
 struct PressExperiment {
   ConfigBuilder<Dim, Scalar> builder;
@@ -22,7 +23,7 @@ struct PressExperiment {
 
   PressExperiment(double beta, double alpha, double noise_std, unsigned seed, int nx = 8, int ny = 4, int nz = 3,
                   double spacing = 100.0, double depth = 60.0, double duration_s = 4.0, double rate_hz = 30.0,
-                  double release_s = HUGE_VAL) {
+                  double release_s = HUGE_VAL, int steps_per_frame = 1) {
     builder.rest = lattice<Dim, Scalar>(nx, ny, nz, spacing);
     const int n = static_cast<int>(builder.rest.size()) / Dim;
     builder.fixed.assign(static_cast<std::size_t>(n), 0);
@@ -56,13 +57,15 @@ struct PressExperiment {
     record(0.0);
     Eigen::Matrix<Scalar, Dim, 1> target = truth.model.rest[tool];
     MsmStepInput<Dim, Scalar> in;
-    in.dt = static_cast<Scalar>(1.0 / rate_hz);
+    in.dt = static_cast<Scalar>(1.0 / (rate_hz * steps_per_frame));
     for (int k = 1; k < frames; ++k) {
-      const double t = k / rate_hz;
-      target(1) = static_cast<Scalar>(static_cast<double>(truth.model.rest[tool](1)) - depth * std::min(1.0, t));
-      in.driven = {&tool, &target, t <= release_s ? 1 : 0};
-      (void)msm_step(truth.model, params, in, truth.state);
-      record(t);
+      for (int j = 1; j <= steps_per_frame; ++j) {
+        const double t = (k - 1 + static_cast<double>(j) / steps_per_frame) / rate_hz;
+        target(1) = static_cast<Scalar>(static_cast<double>(truth.model.rest[tool](1)) - depth * std::min(1.0, t));
+        in.driven = {&tool, &target, k / rate_hz <= release_s ? 1 : 0};
+        (void)msm_step(truth.model, params, in, truth.state);
+      }
+      record(k / rate_hz);
     }
     // The estimator's rest shape is the first observed frame, as with a camera.
     for (std::size_t i = 0; i < builder.rest.size(); ++i) builder.rest[i] = positions[i];

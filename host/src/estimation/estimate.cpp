@@ -11,6 +11,7 @@
 #include <vector>
 #include <stdexcept>
 
+#include "pliant/host/cluster_radii.hpp"
 #include "pliant/host/parallel_fits.hpp"
 
 namespace pliant::host {
@@ -36,7 +37,8 @@ struct StagedProgress {
   int stages = 1;
   static void forward(void* self, int done, int total) {
     const auto* p = static_cast<const StagedProgress*>(self);
-    p->callback(p->context, p->stage * total + done, p->stages * total);
+    // Stages beyond those planned (more rounds or radii than foreseen) extend the total.
+    p->callback(p->context, p->stage * total + done, std::max(p->stages, p->stage + 1) * total);
   }
 };
 
@@ -171,6 +173,8 @@ void score_candidates(const std::vector<MsmFit<Dim>>& fits, BaselineChoice& choi
 // model filters the tool's noise) and biases msm_beta. The factor allows for that noise
 // propagating through the model built on them.
 constexpr double kExplainedByNoise = 1.5;
+// Radii tried in each gap between fitted cluster radii (fit_baseline, step 3).
+constexpr int kRadiiPerGap = 2;
 
 bool explained_by_noise(double rms, double noise_std) { return noise_std > 0 && rms <= kExplainedByNoise * noise_std; }
 
@@ -223,6 +227,10 @@ std::string choice_reason(const BaselineChoice& choice, bool compared_alpha, boo
 //    msm_alpha held and fitted as the options say;
 // 3. with the cluster radius automatic, the steps and msm_alpha mode kept so far at every radius
 //    of the setup's and auto_cluster_radii;
+//    then, in every gap between two radii fitted so far (in later rounds only beside the kept
+//    radius), up to kRadiiPerGap radii at which the clusters change (cluster_radii.hpp: an
+//    irregular body's clusters change between the listed radii, and the fit over the radius is
+//    not unimodal, so the first round searches every gap);
 // 4. when step 3 moved the radius, steps 2 and 3 again from there (at most twice more): the
 //    radius trades off against msm_alpha and the steps, so each is chosen given the other.
 // Every variant is fitted once. `model` is replaced by the model of the radius kept.
@@ -298,6 +306,25 @@ MsmFit<Dim> fit_baseline(const Recording& recording, const EstimateOptions& opti
     score_candidates<Dim>(fits, choice);
   };
   auto kept = [&]() { return choice.candidates[static_cast<std::size_t>(choice.chosen)]; };
+  // In the kept steps and msm_alpha mode, the radii between consecutive fitted radii at which
+  // the clusters change (cluster_radii.hpp), up to kRadiiPerGap per gap: in every gap, or only
+  // in the two gaps beside the kept radius.
+  auto radii_in_gaps = [&](const BaselineCandidate& form, bool beside_kept_only) {
+    std::vector<double> fitted;
+    for (const BaselineCandidate& c : choice.candidates) fitted.push_back(c.cluster_radius_factor);
+    std::sort(fitted.begin(), fitted.end());
+    fitted.erase(std::unique(fitted.begin(), fitted.end()), fitted.end());
+    const HostMsmModel<Dim>& any = model_for(setup_radius);
+    std::vector<Variant> between;
+    for (std::size_t j = 0; j + 1 < fitted.size(); ++j) {
+      const bool beside = fitted[j] == form.cluster_radius_factor || fitted[j + 1] == form.cluster_radius_factor;
+      if (beside_kept_only && !beside) continue;
+      for (double radius : membership_radii(any.rest, Dim, any.model.spacing, fitted[j], fitted[j + 1], kRadiiPerGap)) {
+        between.push_back({form.steps_per_frame, form.alpha_fitted, radius});
+      }
+    }
+    return between;
+  };
 
   add({{first_steps, alpha_fit, setup_radius}});
   const bool choosing = alpha_auto || steps_auto || radius_auto;
@@ -323,6 +350,7 @@ MsmFit<Dim> fit_baseline(const Recording& recording, const EstimateOptions& opti
       std::vector<Variant> radii{{form.steps_per_frame, form.alpha_fitted, setup_radius}};
       for (double other : auto_cluster_radii) radii.push_back({form.steps_per_frame, form.alpha_fitted, other});
       add(radii);
+      add(radii_in_gaps(kept(), round > 0));
       if (kept().cluster_radius_factor == radius) break;
       radius = kept().cluster_radius_factor;
     }

@@ -41,6 +41,8 @@ class EstimatorOf final : public Estimator {
     model_ = build_msm_model<Dim>(recording, MsmSetupOptions{});
     OnlineDeformabilityConfig config;
     config.candidates = options.candidates;
+    config.alpha_candidates = options.alpha_candidates;
+    config.step_candidates = options.step_candidates;
     block_.resize(online_deformability_workspace_size(model_->model, config));
     Arena arena(block_.data(), block_.size());
     require_ok(online_deformability_init(arena, model_->model, base_params<Dim>(recording, options.msm_alpha), config,
@@ -144,6 +146,15 @@ ReplaySummary replay_recording(const Recording& recording, const ReplayOptions& 
     throw std::invalid_argument("replay speed must be a positive number");
   }
   if (options.candidates < 3) throw std::invalid_argument("the online estimator needs at least 3 candidates");
+  if (options.alpha_candidates < 1 || options.alpha_candidates > kMaxOnlineAlphaRows) {
+    throw std::invalid_argument("the online estimator takes 1 to " + std::to_string(kMaxOnlineAlphaRows) +
+                                " msm_alpha rows");
+  }
+  if (options.step_candidates < 1 || options.step_candidates > kMaxOnlineStepRows) {
+    throw std::invalid_argument("the online estimator takes 1 to " + std::to_string(kMaxOnlineStepRows) +
+                                " rows of steps per frame");
+  }
+  if (!(options.msm_alpha > 0 && options.msm_alpha <= 1)) throw std::invalid_argument("msm_alpha must be in (0, 1]");
   const hal::FaultScript script = parse_script(options.fault_script);
   const ReplayChannels channels = replay_channels_of(recording);
   const bool stepped = options.timing.mode == hal::ReplayMode::stepped;

@@ -31,9 +31,12 @@ enum class AlphaMode : std::uint8_t { automatic, fitted, fixed };
 inline constexpr int max_auto_steps_per_frame = 4;
 
 /// Cluster radii (times the median nearest-neighbour distance of the rest shape) the automatic
-/// choice tries besides the setup's own (1.5 by default): the spread seen between objects and
-/// simulators that were not ours, in steps the fit can tell apart.
-inline constexpr double auto_cluster_radii[] = {1.3, 1.75, 2.0, 2.25};
+/// choice tries first besides the setup's own (1.5 by default), then the radii between them at
+/// which the clusters change (cluster_radii.hpp). They lie between the distances of square and
+/// hexagonal lattices (1, sqrt 2, sqrt 3, 2, sqrt 5, sqrt 6; and 1, sqrt 3, 2, sqrt 7 spacings),
+/// so on a lattice with a noisy rest shape each takes in whole shells of neighbours and the
+/// search between them finds nothing more to fit.
+inline constexpr double auto_cluster_radii[] = {1.3, 1.85, 2.1, 2.3};
 
 struct EstimateOptions {
   FitMode mode = FitMode::trajectory;

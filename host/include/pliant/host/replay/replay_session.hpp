@@ -37,8 +37,10 @@ struct ReplayOptions {
   hal::ReplayTiming timing{hal::ReplayMode::stepped, 1.0};
   std::string fault_script;  ///< script text (empty: no faults)
   bool estimate = true;      ///< run the online msm_beta estimate on the particle frames
-  double msm_alpha = 1.0;
-  int candidates = 21;  ///< online estimator grid size (>= 3)
+  double msm_alpha = 1.0;    ///< held msm_alpha when alpha_candidates is 1
+  int candidates = 21;       ///< online estimator msm_beta grid size per alpha row (>= 3)
+  int alpha_candidates = 3;  ///< msm_alpha rows on [0.3, 1]; 1: hold msm_alpha
+  int step_candidates = 3;   ///< rows at 1, 2, 4 MSM steps per frame; the form is chosen online by BIC
 };
 
 enum class ReplayDevice : std::uint8_t { particles, wrench, gripper };
