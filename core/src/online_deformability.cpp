@@ -146,7 +146,7 @@ Status online_deformability_update(const MsmModel<Dim, Scalar>& model, OnlineDef
 
 namespace {
 
-// The least residual of one alpha row over msm_beta: the parabola through the best grid point
+// The least residual of one row (model form) over msm_beta: the parabola through the best grid point
 // and its neighbours (the best grid point itself when the parabola is not convex).
 struct RowMinimum {
   double msm_beta = 0;
