@@ -146,8 +146,8 @@ Status online_deformability_update(const MsmModel<Dim, Scalar>& model, OnlineDef
 
 namespace {
 
-// The least residual of one row (model form) over msm_beta: the parabola through the best grid point
-// and its neighbours (the best grid point itself when the parabola is not convex).
+// The least residual of one row (model form) over msm_beta: the parabola through the best grid
+// point and its neighbours (the best grid point itself when the parabola is not convex).
 struct RowMinimum {
   double msm_beta = 0;
   double sum_squares = 0;
