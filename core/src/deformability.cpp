@@ -406,13 +406,15 @@ struct Sample {
   TrajectoryError error;
 };
 
-// One beta search at fixed alpha. Records the curve in the workspace when `record` is set;
-// without `uncertainty` only the estimate and its error are filled in (the msm_alpha profile).
+// One beta search at fixed alpha: a grid over [range_lo, range_hi] (all of [0, 1] unless the
+// msm_alpha profile narrows it), then Brent. Records the curve in the workspace when `record` is
+// set; without `uncertainty` only the estimate and its error are filled in (the profile).
 template <int Dim, typename Scalar>
 Status search_beta(const MsmModel<Dim, Scalar>& model, MsmParams<Dim, Scalar> params,
                    const ObservationSequence<Dim, Scalar>& obs, const DeformabilityConfig& config,
                    bool observed_everywhere, DeformabilityWorkspace<Dim, Scalar>& ws, bool record, bool uncertainty,
-                   Progress& progress, DeformabilityResult& result) noexcept {
+                   Progress& progress, DeformabilityResult& result, double range_lo = 0.0,
+                   double range_hi = 1.0) noexcept {
   int curve = 0;
   Sample best{0, {}};
   best.error.mean_distance = std::numeric_limits<double>::infinity();
@@ -441,8 +443,9 @@ Status search_beta(const MsmModel<Dim, Scalar>& model, MsmParams<Dim, Scalar> pa
   int best_grid = 0;
   double best_grid_error = std::numeric_limits<double>::infinity();
   double* grid_errors = ws.grid_error;
+  const double step = (range_hi - range_lo) / (grid - 1);
   for (int i = 0; i < grid; ++i) {
-    const double beta = static_cast<double>(i) / (grid - 1);
+    const double beta = range_lo + static_cast<double>(i) * step;
     const TrajectoryError e = evaluate(beta);
     grid_errors[i] = e.count > 0 ? e.mean_distance : std::numeric_limits<double>::infinity();
     if (e.count > 0 && e.mean_distance < best_grid_error) {
@@ -456,13 +459,12 @@ Status search_beta(const MsmModel<Dim, Scalar>& model, MsmParams<Dim, Scalar> pa
 
   // Brent refinement inside the bracket of the best grid point's neighbours, started from the
   // three grid samples around it.
-  const double step = 1.0 / (grid - 1);
   const auto grid_point = [&](int i) {
     const int k = std::clamp(i, 0, grid - 1);
-    return Point{static_cast<double>(k) * step, grid_errors[k]};
+    return Point{range_lo + static_cast<double>(k) * step, grid_errors[k]};
   };
-  const double lo = std::max(0.0, (best_grid - 1) * step);
-  const double hi = std::min(1.0, (best_grid + 1) * step);
+  const double lo = std::max(range_lo, range_lo + (best_grid - 1) * step);
+  const double hi = std::min(range_hi, range_lo + (best_grid + 1) * step);
   // w and v of Brent's method: the better and the worse neighbour (at an end of the grid, the
   // next two points inward).
   Point near_better = best_grid > 0 ? grid_point(best_grid - 1) : grid_point(best_grid + 2);
@@ -622,19 +624,54 @@ Status estimate_deformability(const MsmModel<Dim, Scalar>& model, const MsmParam
   if (!config.estimate_alpha || config.mode != FitMode::trajectory) {
     return search_beta(model, base, observations, config, observed_everywhere, workspace, true, true, progress, result);
   }
-  // msm_alpha: coarse grid, then golden-section on the profile min_beta E(alpha, beta).
+  // msm_alpha: coarse grid, then golden-section on the profile min_beta E(alpha, beta). The
+  // profile's beta moves little between the alphas golden-section visits, so there each beta
+  // search starts from the beta of the best alpha so far, on a grid of 3 over +-kWarmBeta; a
+  // minimum on that grid's inner edge is searched again over all of [0, 1].
+  constexpr double kWarmBeta = 0.1;
   DeformabilityConfig inner = config;
   inner.grid_points = std::min(config.grid_points, 6);
   inner.tolerance = std::max(config.tolerance, 5e-3);
+  DeformabilityConfig warm = inner;
+  warm.grid_points = 3;
   progress.planned = (5 + 14) * planned_search_evaluations(inner, false) + planned_search_evaluations(config, probes);
   MsmParams<Dim, Scalar> params = base;
+  double best_profile = std::numeric_limits<double>::infinity();
+  double best_profile_beta = std::numeric_limits<double>::quiet_NaN();
+  double last_beta = 0.0;  // the beta of the last profile value
   auto profile = [&](double alpha) -> double {
     params.msm_alpha = static_cast<Scalar>(alpha);
     DeformabilityResult trial;
-    const Status s =
-        search_beta(model, params, observations, inner, observed_everywhere, workspace, false, false, progress, trial);
-    result.evaluations += trial.evaluations;
-    return s == Status::ok ? trial.error : std::numeric_limits<double>::infinity();
+    Status s = Status::no_observations;
+    bool searched = false;
+    if (std::isfinite(best_profile_beta)) {
+      const double lo = std::max(0.0, best_profile_beta - kWarmBeta);
+      const double hi = std::min(1.0, best_profile_beta + kWarmBeta);
+      s = search_beta(model, params, observations, warm, observed_everywhere, workspace, false, false, progress, trial,
+                      lo, hi);
+      const bool on_inner_edge =
+          (lo > 0.0 && trial.msm_beta <= lo + warm.tolerance) || (hi < 1.0 && trial.msm_beta >= hi - warm.tolerance);
+      searched = s == Status::ok && !on_inner_edge;
+      result.evaluations += trial.evaluations;
+    }
+    if (!searched) {
+      trial = DeformabilityResult{};
+      s = search_beta(model, params, observations, inner, observed_everywhere, workspace, false, false, progress,
+                      trial);
+      result.evaluations += trial.evaluations;
+    }
+    if (s != Status::ok) return std::numeric_limits<double>::infinity();
+    last_beta = trial.msm_beta;
+    return trial.error;
+  };
+  // Golden-section's profile: warm-started from, and updating, the best alpha so far.
+  auto refined_profile = [&](double alpha) -> double {
+    const double value = profile(alpha);
+    if (value < best_profile) {
+      best_profile = value;
+      best_profile_beta = last_beta;
+    }
+    return value;
   };
   constexpr int kAlphaGrid = 5;
   double best_alpha = 1.0;
@@ -643,16 +680,18 @@ Status estimate_deformability(const MsmModel<Dim, Scalar>& model, const MsmParam
   const double span = 1.0 - config.alpha_min;
   for (int i = 0; i < kAlphaGrid; ++i) {
     const double alpha = config.alpha_min + span * i / (kAlphaGrid - 1);
-    const double value = profile(alpha);
+    const double value = profile(alpha);  // over all of [0, 1]: the grid's alphas are far apart
     if (value < best_value) {
       best_value = value;
       best_alpha = alpha;
       best_index = i;
+      best_profile = value;
+      best_profile_beta = last_beta;
     }
   }
   double lo = config.alpha_min + span * std::max(0, best_index - 1) / (kAlphaGrid - 1);
   double hi = config.alpha_min + span * std::min(kAlphaGrid - 1, best_index + 1) / (kAlphaGrid - 1);
-  const Minimum refined = golden_section_minimum(profile, lo, hi, 5e-3, 14);
+  const Minimum refined = golden_section_minimum(refined_profile, lo, hi, 5e-3, 14);
   if (refined.value < best_value) best_alpha = refined.x;
   params.msm_alpha = static_cast<Scalar>(best_alpha);
   // search_beta adds its evaluations to those of the profile already in result.evaluations.
