@@ -674,6 +674,7 @@ Status estimate_deformability(const MsmModel<Dim, Scalar>& model, const MsmParam
     return value;
   };
   constexpr int kAlphaGrid = 5;
+  double grid_best_beta = std::numeric_limits<double>::quiet_NaN();
   double best_alpha = 1.0;
   double best_value = std::numeric_limits<double>::infinity();
   int best_index = kAlphaGrid - 1;
@@ -685,10 +686,11 @@ Status estimate_deformability(const MsmModel<Dim, Scalar>& model, const MsmParam
       best_value = value;
       best_alpha = alpha;
       best_index = i;
-      best_profile = value;
-      best_profile_beta = last_beta;
+      grid_best_beta = last_beta;
     }
   }
+  best_profile = best_value;
+  best_profile_beta = grid_best_beta;
   double lo = config.alpha_min + span * std::max(0, best_index - 1) / (kAlphaGrid - 1);
   double hi = config.alpha_min + span * std::min(kAlphaGrid - 1, best_index + 1) / (kAlphaGrid - 1);
   const Minimum refined = golden_section_minimum(refined_profile, lo, hi, 5e-3, 14);
