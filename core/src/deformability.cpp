@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "pliant/core/curve_analysis.hpp"
+#include "step_interval.hpp"
 
 namespace pliant {
 namespace {
@@ -129,31 +130,6 @@ void accumulate_frame(const MsmModel<Dim, Scalar>& model, const ObservationSeque
   error.count += used;
 }
 
-// Steps the model over one frame interval of length dt toward the gathered targets: one step
-// straight to them, or `steps` steps toward targets interpolated from the interval's start.
-template <int Dim, typename Scalar>
-void step_frame_interval(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>& params, Scalar dt,
-                         int target_count, int steps, DeformabilityWorkspace<Dim, Scalar>& ws) noexcept {
-  MsmStepInput<Dim, Scalar> input;
-  input.driven.count = target_count;
-  input.driven.ids = ws.target_ids;
-  if (steps == 1) {
-    input.dt = dt;
-    input.driven.positions = ws.targets;
-    (void)msm_step(model, params, input, ws.state);
-    return;
-  }
-  input.dt = dt / static_cast<Scalar>(steps);
-  input.driven.positions = ws.step_targets;
-  for (int j = 1; j <= steps; ++j) {
-    const Scalar share = static_cast<Scalar>(j) / static_cast<Scalar>(steps);
-    for (int c = 0; c < target_count; ++c) {
-      ws.step_targets[c] = ws.interval_start[c] + (ws.targets[c] - ws.interval_start[c]) * share;
-    }
-    (void)msm_step(model, params, input, ws.state);
-  }
-}
-
 template <int Dim, typename Scalar>
 void run_trajectory(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>& params,
                     const ObservationSequence<Dim, Scalar>& obs, int steps_per_frame, bool observed_everywhere,
@@ -169,7 +145,9 @@ void run_trajectory(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Sca
   for (int k = 1; k < obs.frame_count; ++k) {
     const auto dt = static_cast<Scalar>(obs.times_s[k] - obs.times_s[k - 1]);
     const int target_count = gather_targets(obs, k, state, ws);
-    step_frame_interval(model, params, dt, target_count, steps_per_frame, ws);
+    // The interval starts where each driven particle was held (step_interval.hpp).
+    (void)detail::step_frame_interval(model, params, dt, ws.target_ids, ws.interval_start, ws.targets, target_count,
+                                      steps_per_frame, ws.step_targets, state);
     if (observed_everywhere) {
       accumulate_frame<true>(model, obs, k, state, ws.residual_sum, ws.residual_samples, error);
     } else {

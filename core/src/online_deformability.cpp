@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "pliant/core/curve_analysis.hpp"
+#include "step_interval.hpp"
 
 namespace pliant {
 
@@ -65,38 +66,15 @@ void online_deformability_reset(const MsmModel<Dim, Scalar>& model,
 
 namespace {
 
-// Advances one candidate over a frame interval of length dt: one MSM step straight to the driven
-// targets, or `steps` steps of dt / steps toward targets interpolated linearly from where each
-// driven particle was at the interval's start (its previous target, or its simulated position
-// when it was free). Returns the worst status of the steps.
+// Where each driven particle starts the frame interval: its previous target, or its simulated
+// position when it was free (an unknown id: its own target, which msm_step then drops).
 template <int Dim, typename Scalar>
-Status step_frame_interval(const MsmModel<Dim, Scalar>& model, const MsmParams<Dim, Scalar>& params, Scalar dt,
-                           const MsmDrivenTargets<Dim, Scalar>& driven, int steps,
-                           OnlineDeformability<Dim, Scalar>& estimator, MsmState<Dim, Scalar>& state) noexcept {
-  MsmStepInput<Dim, Scalar> input;
-  if (steps == 1) {
-    input.dt = dt;
-    input.driven = driven;
-    return msm_step(model, params, input, state);
-  }
+void interval_start(const MsmModel<Dim, Scalar>& model, const MsmDrivenTargets<Dim, Scalar>& driven,
+                    const MsmState<Dim, Scalar>& state, Eigen::Matrix<Scalar, Dim, 1>* start) noexcept {
   for (int c = 0; c < driven.count; ++c) {
     const int id = driven.ids[c];
-    const bool known = id >= 0 && id < model.particle_count;
-    estimator.step_start[c] = known ? state.position[id] : driven.positions[c];
+    start[c] = id >= 0 && id < model.particle_count ? state.position[id] : driven.positions[c];
   }
-  input.dt = dt / static_cast<Scalar>(steps);
-  input.driven = MsmDrivenTargets<Dim, Scalar>{driven.ids, estimator.step_targets, driven.count};
-  Status worst = Status::ok;
-  for (int j = 1; j <= steps; ++j) {
-    const Scalar share = static_cast<Scalar>(j) / static_cast<Scalar>(steps);
-    for (int c = 0; c < driven.count; ++c) {
-      estimator.step_targets[c] = estimator.step_start[c] + (driven.positions[c] - estimator.step_start[c]) * share;
-    }
-    const Status stepped = msm_step(model, params, input, state);
-    if (stepped != Status::ok && worst == Status::ok) worst = stepped;
-    if (stepped == Status::invalid_argument || stepped == Status::not_initialized) return stepped;
-  }
-  return worst;
 }
 
 }  // namespace
@@ -121,7 +99,11 @@ Status online_deformability_update(const MsmModel<Dim, Scalar>& model, OnlineDef
     params.msm_beta = static_cast<Scalar>(static_cast<double>(c % k) / (k - 1));
     params.msm_alpha = static_cast<Scalar>(estimator.row_alpha(c / k));
     MsmState<Dim, Scalar>& state = estimator.states[c];
-    const Status stepped = step_frame_interval(model, params, dt, driven, estimator.row_steps(c / k), estimator, state);
+    const int steps = estimator.row_steps(c / k);
+    if (steps > 1) interval_start(model, driven, state, estimator.step_start);
+    const Status stepped =
+        detail::step_frame_interval(model, params, dt, driven.ids, estimator.step_start, driven.positions, driven.count,
+                                    steps, estimator.step_targets, state);
     if (stepped == Status::invalid_argument || stepped == Status::not_initialized) {
       ++estimator.rejected_frames;
       return Status::invalid_argument;
