@@ -37,7 +37,7 @@ set(PLIANT_FEM_SOURCES
   ${pliant_host_src}/fem/fem_modal.cpp
   ${pliant_host_src}/fem/fem_recording.cpp
   ${pliant_host_src}/fem/material_map.cpp)
-# the one Levenberg-Marquardt path, on Ceres (fem/least_squares_fit.hpp)
+# the one least-squares path, on Ceres (least_squares_fit.hpp)
 set(PLIANT_FIT_SOURCES
   ${pliant_host_src}/fit/least_squares_fit.cpp)
 # FEM material estimators: static, dynamic (trajectory), rest shape (fem/estimate_*.hpp)
@@ -65,6 +65,8 @@ set(PLIANT_DIAGNOSIS_SOURCES
   ${pliant_host_src}/diagnose/locate.cpp
   ${pliant_host_src}/diagnose/model_run.cpp
   ${pliant_host_src}/diagnose/effects.cpp
+  ${pliant_host_src}/diagnose/selection.cpp
+  ${pliant_host_src}/diagnose/engine.cpp
   ${pliant_host_src}/diagnose/diagnose.cpp
   ${pliant_host_src}/diagnose/fem_model_run.cpp
   ${pliant_host_src}/diagnose/fem_effects.cpp

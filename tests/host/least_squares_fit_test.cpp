@@ -1,8 +1,9 @@
 // fit_least_squares against problems with known answers: closed-form linear regression (value
 // and standard error), convergence from starts 10x off on a log scale, robustness to outliers,
 // bounds, and undetermined parameters.
-#include "pliant/host/fem/least_squares_fit.hpp"
+#include "pliant/host/least_squares_fit.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <stdexcept>
@@ -12,10 +13,10 @@
 
 namespace {
 
-using pliant::host::fem::fit_least_squares;
-using pliant::host::fem::FitOptions;
-using pliant::host::fem::FitParameter;
-using pliant::host::fem::RobustLoss;
+using pliant::host::fit_least_squares;
+using pliant::host::FitOptions;
+using pliant::host::FitParameter;
+using pliant::host::RobustLoss;
 
 struct Line {
   std::vector<double> x, y;
@@ -225,6 +226,82 @@ TEST(LeastSquaresFit, RejectsInconsistentProblems) {
   EXPECT_THROW(fit_least_squares({{"x", 1.0, 0.5, 2.0, true}}, 1,
                                  [](const std::vector<double>&, std::vector<double>&) { return false; }),
                std::invalid_argument);
+  EXPECT_THROW(fit_least_squares({{"x", 1.0, 1.0, 1.0, false}}, 1, zero), std::invalid_argument);
+  FitOptions no_damping;
+  no_damping.initial_damping = 0.0;
+  EXPECT_THROW(fit_least_squares({{"x", 1.0, 0.5, 2.0, true}}, 1, zero, no_damping), std::invalid_argument);
+}
+
+// Diagnosis starts fits from grid points on the edges of the unit search box: a start on a
+// bound moves inwards to an interior minimum.
+TEST(LeastSquaresFit, StartsOnABound) {
+  FitOptions options;
+  options.loss = RobustLoss::none;
+  options.central_differences = false;
+  for (const double start : {0.0, 1.0}) {
+    const auto result = fit_least_squares(
+        {{"u", start, 0.0, 1.0, false}}, 2,
+        [](const std::vector<double>& v, std::vector<double>& r) {
+          r[0] = v[0] - 0.3;
+          r[1] = 2.0 * (v[0] - 0.3);
+          return true;
+        },
+        options);
+    EXPECT_NEAR(result.values[0], 0.3, 1e-6) << "start " << start;
+    EXPECT_FALSE(result.at_bound[0]);
+  }
+}
+
+// Every residual evaluation may be a long simulation: no point is run twice (Ceres asks for an
+// accepted trial point again with its Jacobian; the fit evaluates its start and its solution),
+// and `evaluations` counts the model runs made.
+TEST(LeastSquaresFit, NeverRunsTheModelTwiceAtOnePoint) {
+  std::vector<double> t, y;
+  for (int i = 0; i < 40; ++i) {
+    t.push_back(0.1 * i);
+    y.push_back(2.0 * std::exp(-t.back() / 0.8) + 0.01 * std::sin(7.0 * i));
+  }
+  std::vector<std::vector<double>> asked;
+  const auto residuals = [&](const std::vector<double>& v, std::vector<double>& r) {
+    asked.push_back(v);
+    for (size_t i = 0; i < t.size(); ++i) r[i] = v[0] * std::exp(-t[i] / v[1]) - y[i];
+    return true;
+  };
+  for (const bool central : {true, false}) {
+    asked.clear();
+    FitOptions options;
+    options.loss = RobustLoss::none;
+    options.central_differences = central;
+    const auto result =
+        fit_least_squares({{"amplitude", 1.0, 1e-2, 1e2, true}, {"time_constant", 2.0, 1e-2, 1e2, true}},
+                          static_cast<int>(t.size()), residuals, options);
+    EXPECT_NEAR(result.values[1], 0.8, 0.02);
+    EXPECT_EQ(result.evaluations, static_cast<int>(asked.size()));
+    std::vector<std::vector<double>> unique = asked;
+    std::sort(unique.begin(), unique.end());
+    EXPECT_EQ(std::unique(unique.begin(), unique.end()), unique.end()) << "central " << central;
+  }
+}
+
+// Without uncertainty the fit ends at the same point, takes no Jacobian for the covariance and
+// reports none.
+TEST(LeastSquaresFit, UncertaintyCanBeLeftToTheCaller) {
+  const auto residuals = [](const std::vector<double>& v, std::vector<double>& r) {
+    r[0] = v[0] - 0.4;
+    r[1] = v[0] * v[0] - 0.16;
+    r[2] = 0.1 * (v[0] - 0.4);
+    return true;
+  };
+  FitOptions with;
+  with.loss = RobustLoss::none;
+  FitOptions without = with;
+  without.uncertainty = false;
+  const auto a = fit_least_squares({{"x", 0.9, 0.0, 1.0, false}}, 3, residuals, with);
+  const auto b = fit_least_squares({{"x", 0.9, 0.0, 1.0, false}}, 3, residuals, without);
+  EXPECT_EQ(a.values, b.values);
+  EXPECT_TRUE(std::isfinite(a.standard_deviations[0]));
+  EXPECT_TRUE(std::isnan(b.standard_deviations[0]));
+  EXPECT_LE(b.evaluations, a.evaluations);
 }
 
 }  // namespace

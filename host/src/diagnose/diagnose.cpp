@@ -18,18 +18,18 @@
 #include "pliant/host/diagnose/model_run.hpp"
 #include "pliant/host/diagnose/noise_floor.hpp"
 #include "pliant/host/diagnose/residual_field.hpp"
+#include "pliant/host/diagnose/selection.hpp"
 #include "pliant/host/estimate.hpp"
+#include "pliant/host/least_squares_fit.hpp"
 #include "pliant/host/parallel_fits.hpp"
+#include "engine.hpp"
+#include "words.hpp"
 
 namespace pliant::host {
 namespace {
 
-constexpr int kMinFrames = 10;
-constexpr double kMinImprovement = 0.3;   // held-out rms must fall by 30 % ...
-constexpr double kMinBicGain = 10.0;      // ... with "very strong" evidence (Kass-Raftery) ...
-constexpr double kMinSignificance = 3.0;  // ... and a parameter 3 std from its null
-constexpr double kMinMisfit = 1.5;        // baseline held-out rms / noise rms worth explaining
-constexpr double kUnknownMisfit = 5.0;    // unexplained misfit that is reported as `unknown`
+using words::id_list;
+using words::number;
 
 // Sums of squared Euclidean residuals over the compared pairs of fitting and held-out frames.
 struct Score {
@@ -81,6 +81,9 @@ class Scorer {
     return Eigen::Map<Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
   }
 
+  /// The number of scalars fit_residuals returns.
+  int fit_residual_count() const { return static_cast<int>(fit_residual_particles().size()); }
+
   /// The particle of every scalar fit_residuals returns, in the same order.
   std::vector<int> fit_residual_particles() const {
     std::vector<int> ids;
@@ -99,15 +102,9 @@ class Scorer {
   /// Held-out residual sum of squares and compared pairs per held-out block (a run of
   /// consecutive held-out frames), in frame order: what a block bootstrap of frames resamples.
   std::vector<Score> held_blocks(const std::vector<double>& simulated) const {
-    // Block index of every held-out frame, counted in frame order.
-    std::vector<int> block_of(held_out_.size(), -1);
-    int blocks_seen = 0;
-    for (std::size_t k = 0; k < held_out_.size(); ++k) {
-      if (held_out_[k] == 0) continue;
-      if (k == 0 || held_out_[k - 1] == 0) ++blocks_seen;
-      block_of[k] = blocks_seen - 1;
-    }
-    std::vector<Score> blocks(static_cast<std::size_t>(blocks_seen));
+    int block_count = 0;
+    const std::vector<int> block_of = held_block_of_frame(held_out_, block_count);
+    std::vector<Score> blocks(static_cast<std::size_t>(block_count));
     for_each_pair(simulated, [&](int frame, double squared) {
       const int block = block_of[static_cast<std::size_t>(frame)];
       if (block < 0) return;
@@ -421,72 +418,44 @@ class Fitter {
     return cost;
   }
 
-  // Bounded Levenberg-Marquardt in the unit coordinates: forward-difference Jacobian, bounds by
-  // projection, coordinates held at a bound while the gradient pushes outward. Returns the
-  // fitting-frame residual sum of squares at the final u.
+  // Bounded Levenberg-Marquardt (fit_least_squares) on the free coordinates, in the unit search
+  // box: forward differences (every evaluation is a simulation), plain least squares, stopped
+  // when a step gains less than 1e-5 of the cost. The uncertainty is finish()'s. Returns the
+  // fitting-frame residual sum of squares at the final u (u unchanged, and the sum at u, when
+  // the model cannot be evaluated there).
   double levenberg_marquardt(const Effect* effect, std::vector<double>& u) {
     const std::vector<int> coordinates = free_coordinates(effect, u.size());
-    const int p = static_cast<int>(u.size());
-    Eigen::VectorXd r = residuals(effect, u);
-    double cost = r.squaredNorm();
-    double lambda = 1e-2;
-    for (int iteration = 0; iteration < 25; ++iteration) {
-      Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(r.size(), p);
-      for (int c : coordinates) {
-        const double h = u[static_cast<std::size_t>(c)] + 0.005 <= 1.0 ? 0.005 : -0.005;
-        std::vector<double> probe = u;
-        probe[static_cast<std::size_t>(c)] += h;
-        jacobian.col(c) = (residuals(effect, probe) - r) / h;
-      }
-      const Eigen::VectorXd gradient = jacobian.transpose() * r;
-      std::vector<int> free;
-      for (int c : coordinates) {
-        const double uc = u[static_cast<std::size_t>(c)];
-        const double gc = gradient(c);
-        if ((uc <= 0.0 && gc > 0) || (uc >= 1.0 && gc < 0)) continue;
-        if (jacobian.col(c).squaredNorm() > 0) free.push_back(c);
-      }
-      if (free.empty()) break;
-      const int m = static_cast<int>(free.size());
-      Eigen::MatrixXd normal(m, m);
-      Eigen::VectorXd g(m);
-      for (int a = 0; a < m; ++a) {
-        g(a) = gradient(free[static_cast<std::size_t>(a)]);
-        for (int b = 0; b < m; ++b) {
-          normal(a, b) =
-              jacobian.col(free[static_cast<std::size_t>(a)]).dot(jacobian.col(free[static_cast<std::size_t>(b)]));
-        }
-      }
-      bool accepted = false;
-      double new_cost = cost;
-      for (int attempt = 0; attempt < 8 && !accepted; ++attempt) {
-        Eigen::MatrixXd damped = normal;
-        for (int a = 0; a < m; ++a) damped(a, a) += lambda * std::max(normal(a, a), 1e-12);
-        const Eigen::VectorXd delta = damped.ldlt().solve(-g);
-        std::vector<double> trial = u;
-        for (int a = 0; a < m; ++a) {
-          double& value = trial[static_cast<std::size_t>(free[static_cast<std::size_t>(a)])];
-          value = std::clamp(value + (std::isfinite(delta(a)) ? delta(a) : 0.0), 0.0, 1.0);
-        }
-        if (trial == u) break;
-        const Eigen::VectorXd rt = residuals(effect, trial);
-        const double ct = rt.squaredNorm();
-        if (ct < cost) {
-          accepted = true;
-          new_cost = ct;
-          u = trial;
-          r = rt;
-          lambda = std::max(lambda / 4.0, 1e-7);
-        } else {
-          lambda *= 6.0;
-        }
-      }
-      if (!accepted) break;
-      const double gain = cost - new_cost;
-      cost = new_cost;
-      if (gain < 1e-5 * cost) break;
+    std::vector<FitParameter> parameters;
+    for (int c : coordinates) {
+      parameters.push_back(
+          {coordinate_name(effect, c), std::clamp(u[static_cast<std::size_t>(c)], 0.0, 1.0), 0.0, 1.0, false});
     }
-    return cost;
+    const ResidualFunction function = [&](const std::vector<double>& values, std::vector<double>& out) {
+      std::vector<double> trial = u;
+      for (std::size_t k = 0; k < coordinates.size(); ++k) trial[static_cast<std::size_t>(coordinates[k])] = values[k];
+      const Eigen::VectorXd r = residuals(effect, trial);
+      if (r.size() != static_cast<Eigen::Index>(out.size())) return false;
+      std::copy(r.data(), r.data() + r.size(), out.begin());
+      return true;
+    };
+    FitOptions options;
+    options.loss = RobustLoss::none;
+    options.central_differences = false;
+    options.difference_step = 0.005;
+    options.max_iterations = 25;
+    options.function_tolerance = 1e-5;
+    options.parameter_tolerance = 1e-6;
+    options.initial_damping = 1e-2;
+    options.projected_line_search = false;
+    options.uncertainty = false;
+    try {
+      const FitResult result = fit_least_squares(parameters, scorer_.fit_residual_count(), function, options);
+      for (std::size_t k = 0; k < coordinates.size(); ++k)
+        u[static_cast<std::size_t>(coordinates[k])] = result.values[k];
+      return 2.0 * result.final_cost;
+    } catch (const std::exception&) {
+      return residuals(effect, u).squaredNorm();
+    }
   }
 
   // The fit at u with its scores and the std of every fitted parameter.
@@ -550,6 +519,13 @@ class Fitter {
   int evaluations = 0;
 
  private:
+  // Coordinate c's name: msm_beta, msm_alpha, or the effect parameter's.
+  std::string coordinate_name(const Effect* effect, int c) const {
+    if (c == 0) return "msm_beta";
+    if (form_.fit_alpha && c == 1) return "msm_alpha";
+    return effect->parameters[static_cast<std::size_t>(c) - effect_offset()].name;
+  }
+
   // Coordinate c of u in physical units: msm_beta, msm_alpha, or the effect parameter.
   double physical_value(const Effect* effect, const std::vector<double>& u, int c) const {
     if (c == 0) return u[0];
@@ -562,30 +538,6 @@ class Fitter {
   const EffectContext& context_;
   ModelForm form_;
 };
-
-std::string id_list(const std::vector<int>& ids) {
-  std::ostringstream out;
-  for (std::size_t i = 0; i < ids.size();) {
-    std::size_t j = i;
-    while (j + 1 < ids.size() && ids[j + 1] == ids[j] + 1) ++j;
-    if (i > 0) out << ", ";
-    out << ids[i];
-    if (j > i) out << "-" << ids[j];
-    i = j + 1;
-    if (i >= 12 && i < ids.size()) {
-      out << " and " << ids.size() - i << " more";
-      break;
-    }
-  }
-  return out.str();
-}
-
-std::string number(double v) {
-  std::ostringstream out;
-  out.precision(3);
-  out << v;
-  return out.str();
-}
 
 // The region of a per-patch stiffness fit as a sentence.
 std::string describe_region(const std::vector<std::vector<int>>& patches, const PatchSplit& split) {
@@ -637,117 +589,22 @@ FormChoice choose_model_form(const Recording& recording, const DiagnoseOptions& 
   return choice;
 }
 
-// Design effect (Kish 1965) of residuals clustered by particle: 1 + (m - 1) icc, m the residual
-// vectors per particle and icc the share of their variance that persists per particle over the
-// recording. Residuals correlated in time are worth fewer independent samples (n / deff).
-double design_effect(const Eigen::VectorXd& residuals, const std::vector<int>& particles, int particle_count,
-                     int dimension) {
-  std::vector<double> sums(static_cast<std::size_t>(particle_count) * static_cast<std::size_t>(dimension), 0.0);
-  std::vector<long> counts(static_cast<std::size_t>(particle_count), 0);
-  for (Eigen::Index j = 0; j < residuals.size(); ++j) {
-    const auto id = static_cast<std::size_t>(particles[static_cast<std::size_t>(j)]);
-    sums[id * static_cast<std::size_t>(dimension) + static_cast<std::size_t>(j % dimension)] += residuals(j);
-    if (j % dimension == 0) ++counts[id];
+// A fit as selection sees it (selection.hpp): msm_beta and msm_alpha are nuisance coordinates;
+// an effect's parameters are tested against their nulls, a per-patch stiffness against the
+// bulk's msm_beta.
+FitEvidence evidence_of(const Scorer& scorer, const Fit& fit, const Effect* effect) {
+  FitEvidence evidence;
+  evidence.fit_residuals = fit.fit_residuals;
+  evidence.fitted = fit.fitted;
+  for (const Score& block : scorer.held_blocks(fit.simulated)) {
+    evidence.held_blocks.push_back({block.held_rss, block.held_pairs});
   }
-  double between = 0;
-  long used = 0;
-  for (std::size_t id = 0; id < counts.size(); ++id) {
-    if (counts[id] == 0) continue;
-    ++used;
-    for (int d = 0; d < dimension; ++d) {
-      const double sum = sums[id * static_cast<std::size_t>(dimension) + static_cast<std::size_t>(d)];
-      between += sum * sum / static_cast<double>(counts[id]);
-    }
+  evidence.values = fit.values;
+  evidence.std = fit.std;
+  for (std::size_t p = 0; effect != nullptr && p < effect->parameters.size(); ++p) {
+    evidence.nulls.push_back(effect->replaces_beta ? fit.beta : effect->parameters[p].null_value);
   }
-  const double total = residuals.squaredNorm();
-  if (used == 0 || !(total > 0)) return 1.0;
-  const double per_particle = static_cast<double>(residuals.size()) / dimension / static_cast<double>(used);
-  if (!(per_particle > 1.0)) return 1.0;
-  const double icc = std::clamp((between / total - 1.0 / per_particle) / (1.0 - 1.0 / per_particle), 0.0, 1.0);
-  return 1.0 + (per_particle - 1.0) * icc;
-}
-
-// Bayesian information criterion of a fit over n residual scalars worth n_eff independent ones.
-double information_criterion(const Fit& fit, double n, double n_eff) {
-  const double rss = fit.fit_residuals.squaredNorm();
-  return n > 0 && rss > 0 ? n_eff * std::log(rss / n) + fit.fitted * std::log(n_eff) : 0.0;
-}
-
-struct Ranked {
-  std::size_t index = 0;  // into the effects
-  double significance = 0;
-  double improvement = 0;
-  double explained = 0;  // share of the misfit beyond noise explained (min_explained_share)
-  double bic = 0;
-  bool clear = false;   // passes every test but min_explained_share
-  bool passes = false;  // passes every test
-};
-
-// How stable the choice is under a block bootstrap of the held-out frames: resamples of the
-// held-out blocks (with replacement, fixed seed), each re-scoring the fits already made.
-struct Stability {
-  double explains = 0;     // share of resamples in which the chosen effect still improves enough
-  double wins = 0;         // ... and has the lowest held-out rms of the passing candidates
-  std::size_t rival = 0;   // the passing candidate that most often wins instead (== chosen: none)
-  double rival_share = 0;  // its share of wins
-};
-
-constexpr int kBootstrapResamples = 400;
-constexpr double kStableShare = 0.8;  // the named effect must hold in 80 % of resamples
-constexpr double kRivalShare = 0.2;   // a rival winning 20 % of them is reported
-
-Stability selection_stability(const Scorer& scorer, const Fit& baseline, const std::vector<Fit>& fits,
-                              const std::vector<Ranked>& ranked) {
-  const std::vector<Score> base_blocks = scorer.held_blocks(baseline.simulated);
-  std::vector<std::size_t> passing;
-  std::vector<std::vector<Score>> blocks;
-  for (const Ranked& r : ranked) {
-    if (!r.passes) continue;
-    passing.push_back(r.index);
-    blocks.push_back(scorer.held_blocks(fits[r.index].simulated));
-  }
-  Stability out;
-  out.rival = passing.front();
-  if (base_blocks.empty()) return out;
-  std::mt19937_64 random(0x5eed);
-  std::uniform_int_distribution<std::size_t> pick(0, base_blocks.size() - 1);
-  std::vector<int> win_count(passing.size(), 0);
-  int explains = 0;
-  std::vector<std::size_t> sample(base_blocks.size());
-  for (int b = 0; b < kBootstrapResamples; ++b) {
-    for (std::size_t& s : sample) s = pick(random);
-    auto rms_of = [&](const std::vector<Score>& per_block) {
-      double rss = 0;
-      long pairs = 0;
-      for (std::size_t s : sample) {
-        rss += per_block[s].held_rss;
-        pairs += per_block[s].held_pairs;
-      }
-      return pairs > 0 ? std::sqrt(rss / static_cast<double>(pairs)) : 0.0;
-    };
-    const double base = rms_of(base_blocks);
-    std::size_t winner = 0;
-    double winner_rms = std::numeric_limits<double>::infinity();
-    for (std::size_t c = 0; c < passing.size(); ++c) {
-      const double rms = rms_of(blocks[c]);
-      if (c == 0 && base > 0 && 1.0 - rms / base >= kMinImprovement) ++explains;
-      if (rms < winner_rms) {
-        winner_rms = rms;
-        winner = c;
-      }
-    }
-    ++win_count[winner];
-  }
-  out.explains = static_cast<double>(explains) / kBootstrapResamples;
-  out.wins = static_cast<double>(win_count[0]) / kBootstrapResamples;
-  for (std::size_t c = 1; c < passing.size(); ++c) {
-    const double share = static_cast<double>(win_count[c]) / kBootstrapResamples;
-    if (share > out.rival_share) {
-      out.rival_share = share;
-      out.rival = passing[c];
-    }
-  }
-  return out;
+  return evidence;
 }
 
 // Largest displacement of an observed particle from its first observed position.
@@ -803,173 +660,129 @@ FittedModel msm_model(const Fit& fit, const ModelForm& form, const std::string& 
   return model;
 }
 
-}  // namespace
-
-DiagnoseResult diagnose_recording(const Recording& recording, const DiagnoseOptions& options) {
-  const auto started = std::chrono::steady_clock::now();
-  if (options.model == "fem") return diagnose_recording_fem(recording, options);
-  if (options.model != "msm") throw std::runtime_error("model '" + options.model + "' is unknown; use msm or fem");
-  const int frames = recording.frame_count();
-  const int n = recording.particle_count;
-  const int dim = recording.dimension;
-  if (frames < kMinFrames) {
-    throw std::runtime_error("too few frames (" + std::to_string(frames) + "); diagnose needs at least " +
-                             std::to_string(kMinFrames));
-  }
-  auto report = [&](const std::string& stage, int done, int total) {
-    if (options.progress) options.progress(stage, done, total);
-  };
-
-  // Held-out blocks of about 0.1 s.
-  int block = options.holdout_block_frames;
-  if (block <= 0) {
-    const double duration = recording.frame_times_s.back() - recording.frame_times_s.front();
-    const double rate = duration > 0 ? (frames - 1) / duration : 30.0;
-    block = std::max(3, static_cast<int>(std::lround(0.1 * rate)));
-  }
-  std::vector<unsigned char> pairs = compared_pairs(recording);
-  long compared = 0;
-  for (unsigned char p : pairs) compared += p;
-  if (compared == 0) throw std::runtime_error("no particle is observed while free; nothing to compare the model with");
-  Scorer scorer(recording, pairs, interleaved_holdout(frames, block));
-
-  const double noise_std = estimate_noise_std(recording);
-  const double noise_rms = noise_std * std::sqrt(static_cast<double>(dim));
-  if (!(largest_travel(recording) > 5.0 * std::max(noise_rms, 1e-12))) {
-    throw std::runtime_error("nothing moves beyond the measurement noise; there is no deformation to diagnose");
-  }
-
-  report("baseline", 0, 1);
-  const FormChoice form = choose_model_form(recording, options);
-  MsmSetupOptions setup;
-  setup.clusters.radius_factor = form.form.cluster_radius_factor;
-  const RecordingSimulator simulator(recording, setup);
-  EffectContext context;
-  context.dimension = dim;
-  context.particle_count = n;
-  describe_object(simulator, n, dim, context);
-  Fitter fitter(simulator, scorer, context, form.form);
-  const Fit baseline = fitter.fit_baseline();
-  report("baseline", 1, 1);
-
-  DiagnoseResult result;
-  Diagnosis& out = result.diagnosis;
-  out.recording = recording.name;
-  out.noise_rms = noise_rms;
-  out.baseline = msm_model(baseline, form.form, form.reason);
-
-  // Locate.
-  const ResidualField field = make_residual_field(recording.positions, baseline.simulated, n, dim);
-  out.location = locate_mismatch(field, recording.frame_times_s, noise_std);
-  context.located = out.location.particles;
-  context.patches = spatial_patches(simulator.rest(), dim,
-                                    std::max(6, (n - static_cast<int>(recording.fixed.size())) / 8), recording.fixed);
-  const std::map<std::string, double> signatures =
-      residual_signatures(recording, baseline.simulated, field, out.location, noise_std);
-
-  // Candidates.
-  const double misfit = noise_rms > 0 ? out.baseline.rms / noise_rms : std::numeric_limits<double>::infinity();
-  const std::vector<Effect> effects = effect_catalogue(context);
-  // When the selection moved the form away from the plain one (msm_alpha 1, one step per frame,
-  // the setup's radius), every effect is also fitted in the plain form and the better fit kept:
-  // msm_alpha, steps or radius chosen without the effect may have absorbed part of it.
-  ModelForm plain;
-  plain.cluster_radius_factor = options.cluster_radius_factor;
-  const bool refit_plain = options.alpha == AlphaMode::automatic && options.steps_per_frame == 0 &&
-                           options.cluster_radius_auto &&
-                           (form.form.fit_alpha || form.form.steps_per_frame != 1 ||
-                            form.form.cluster_radius_factor != plain.cluster_radius_factor);
-  MsmSetupOptions plain_setup;
-  plain_setup.clusters.radius_factor = plain.cluster_radius_factor;
-  std::unique_ptr<RecordingSimulator> plain_simulator;
-  Fit plain_baseline;
-  int plain_evaluations = 0;
-  if (refit_plain) {
-    plain_simulator = std::make_unique<RecordingSimulator>(recording, plain_setup);
-    Fitter plain_fitter(*plain_simulator, scorer, context, plain);
-    plain_baseline = plain_fitter.fit_baseline();
-    plain_evaluations = plain_fitter.evaluations;
-  }
-  // Every effect is fitted independently: on worker threads, each with its own simulators (a
-  // simulator holds its run state). The result does not depend on the thread count.
-  struct Worker {
-    std::unique_ptr<RecordingSimulator> simulator;  // null: the caller's
-    std::unique_ptr<RecordingSimulator> plain_simulator;
-    int evaluations = 0;
-  };
-  std::vector<Fit> fits(effects.size());
-  std::vector<int> effect_evaluations(effects.size(), 0);
-  int done = 0;
-  report("effects", 0, static_cast<int>(effects.size()));
-  run_on_workers(
-      effects.size(), worker_count(effects.size(), options.threads),
-      [&](bool is_caller) {
-        Worker worker;
-        if (!is_caller) worker.simulator = std::make_unique<RecordingSimulator>(recording, setup);
-        if (refit_plain) {
-          worker.plain_simulator =
-              is_caller ? std::move(plain_simulator) : std::make_unique<RecordingSimulator>(recording, plain_setup);
-        }
-        return worker;
-      },
-      [&](Worker& worker, std::size_t e) {
-        Fitter own(worker.simulator ? *worker.simulator : simulator, scorer, context, form.form);
-        fits[e] = own.fit(&effects[e], baseline);
-        effect_evaluations[e] = own.evaluations;
-        if (!refit_plain) return;
-        Fitter in_plain(*worker.plain_simulator, scorer, context, plain);
-        Fit in_plain_form = in_plain.fit(&effects[e], plain_baseline);
-        effect_evaluations[e] += in_plain.evaluations;
-        if (in_plain_form.fit_residuals.squaredNorm() < fits[e].fit_residuals.squaredNorm()) {
-          fits[e] = std::move(in_plain_form);
-        }
-      },
-      [&]() { report("effects", ++done, static_cast<int>(effects.size())); });
-
-  // Every score counts the residuals as worth n / deff independent samples, deff the design
-  // effect of the best-fitting model's residuals (the same for all, so that the scores compare).
-  const Fit* best_fit = &baseline;
-  for (const Fit& f : fits) {
-    if (f.fit_residuals.squaredNorm() < best_fit->fit_residuals.squaredNorm()) best_fit = &f;
-  }
-  const double deff = design_effect(best_fit->fit_residuals, scorer.fit_residual_particles(), n, dim);
-  const double residual_count = static_cast<double>(baseline.fit_residuals.size());
-  const double n_eff = residual_count / deff;
-  const double baseline_bic = information_criterion(baseline, residual_count, n_eff);
-
-  std::vector<Ranked> ranked;
-  for (std::size_t e = 0; e < effects.size(); ++e) {
-    const Fit& f = fits[e];
-    Ranked r;
-    r.index = e;
-    for (std::size_t p = 0; p < f.values.size(); ++p) {
-      const EffectParameter& parameter = effects[e].parameters[p];
-      // A per-patch stiffness is tested against the bulk msm_beta, others against their null.
-      const double null_value = effects[e].replaces_beta ? f.beta : parameter.null_value;
-      const double std = f.std[p] * std::sqrt(deff);
-      if (std::isfinite(null_value) && std::isfinite(std) && std > 0) {
-        r.significance = std::max(r.significance, std::abs(f.values[p] - null_value) / std);
-      }
+// The MSM as a diagnosis model (engine.hpp).
+class MsmDiagnosis final : public DiagnosisModel {
+ public:
+  MsmDiagnosis(const Recording& recording, const DiagnoseOptions& options)
+      : recording_(recording), options_(options), scorer_(make_scorer(recording, options)) {
+    noise_std_ = estimate_noise_std(recording);
+    noise_rms_ = noise_std_ * std::sqrt(static_cast<double>(recording.dimension));
+    if (!(largest_travel(recording) > 5.0 * std::max(noise_rms_, 1e-12))) {
+      throw std::runtime_error("nothing moves beyond the measurement noise; there is no deformation to diagnose");
     }
-    r.improvement = out.baseline.rms > 0 ? 1.0 - f.score.held_rms() / out.baseline.rms : 0.0;
-    r.bic = information_criterion(f, residual_count, n_eff);
-    r.explained = explained_share(out.baseline.rms, f.score.held_rms(), noise_rms);
-    r.clear = misfit >= kMinMisfit && r.improvement >= kMinImprovement && baseline_bic - r.bic >= kMinBicGain &&
-              r.significance >= kMinSignificance;
-    r.passes = r.clear && r.explained >= min_explained_share;
-    ranked.push_back(r);
   }
-  std::sort(ranked.begin(), ranked.end(), [&](const Ranked& a, const Ranked& b) {
-    if (a.passes != b.passes) return a.passes;
-    return fits[a.index].score.held_rms() < fits[b.index].score.held_rms();
-  });
-  for (const Ranked& r : ranked) {
-    const Fit& f = fits[r.index];
+
+  // The baseline a user would fit: estimate's model form (msm_alpha, steps, radius), then
+  // msm_beta (and msm_alpha when fitted) on the fitting frames.
+  void fit_baseline(Diagnosis& out) override {
+    form_ = choose_model_form(recording_, options_);
+    setup_.clusters.radius_factor = form_.form.cluster_radius_factor;
+    simulator_ = std::make_unique<RecordingSimulator>(recording_, setup_);
+    context_.dimension = recording_.dimension;
+    context_.particle_count = recording_.particle_count;
+    describe_object(*simulator_, recording_.particle_count, recording_.dimension, context_);
+    Fitter fitter(*simulator_, scorer_, context_, form_.form);
+    baseline_ = fitter.fit_baseline();
+    simulations_ += fitter.evaluations;
+    out.noise_rms = noise_rms_;
+    out.baseline = msm_model(baseline_, form_.form, form_.reason);
+  }
+
+  std::map<std::string, double> locate(Diagnosis& out) override {
+    const int n = recording_.particle_count;
+    const int dim = recording_.dimension;
+    const ResidualField field = make_residual_field(recording_.positions, baseline_.simulated, n, dim);
+    out.location = locate_mismatch(field, recording_.frame_times_s, noise_std_);
+    location_ = out.location;
+    context_.located = out.location.particles;
+    context_.patches = spatial_patches(
+        simulator_->rest(), dim, std::max(6, (n - static_cast<int>(recording_.fixed.size())) / 8), recording_.fixed);
+    return residual_signatures(recording_, baseline_.simulated, field, out.location, noise_std_);
+  }
+
+  std::vector<std::string> catalogue() override {
+    effects_ = effect_catalogue(context_);
+    std::vector<std::string> names;
+    for (const Effect& e : effects_) names.push_back(e.name);
+    return names;
+  }
+
+  // Every effect is fitted independently: on worker threads, each with its own simulators (a
+  // simulator holds its run state). The result does not depend on the thread count. When the
+  // baseline's form moved away from the plain one (msm_alpha 1, one step per frame, the
+  // setup's radius), every effect is also fitted in the plain form and the better fit kept:
+  // msm_alpha, steps or radius chosen without the effect may have absorbed part of it.
+  void fit_effects(int threads, const std::function<void()>& one_done) override {
+    ModelForm plain;
+    plain.cluster_radius_factor = options_.cluster_radius_factor;
+    const bool refit_plain = options_.alpha == AlphaMode::automatic && options_.steps_per_frame == 0 &&
+                             options_.cluster_radius_auto &&
+                             (form_.form.fit_alpha || form_.form.steps_per_frame != 1 ||
+                              form_.form.cluster_radius_factor != plain.cluster_radius_factor);
+    MsmSetupOptions plain_setup;
+    plain_setup.clusters.radius_factor = plain.cluster_radius_factor;
+    std::unique_ptr<RecordingSimulator> plain_simulator;
+    Fit plain_baseline;
+    if (refit_plain) {
+      plain_simulator = std::make_unique<RecordingSimulator>(recording_, plain_setup);
+      Fitter plain_fitter(*plain_simulator, scorer_, context_, plain);
+      plain_baseline = plain_fitter.fit_baseline();
+      simulations_ += plain_fitter.evaluations;
+    }
+    struct Worker {
+      std::unique_ptr<RecordingSimulator> simulator;  // null: the caller's
+      std::unique_ptr<RecordingSimulator> plain_simulator;
+    };
+    fits_.assign(effects_.size(), Fit{});
+    std::vector<int> evaluations(effects_.size(), 0);
+    run_on_workers(
+        effects_.size(), worker_count(effects_.size(), threads),
+        [&](bool is_caller) {
+          Worker worker;
+          if (!is_caller) worker.simulator = std::make_unique<RecordingSimulator>(recording_, setup_);
+          if (refit_plain) {
+            worker.plain_simulator =
+                is_caller ? std::move(plain_simulator) : std::make_unique<RecordingSimulator>(recording_, plain_setup);
+          }
+          return worker;
+        },
+        [&](Worker& worker, std::size_t e) {
+          Fitter own(worker.simulator ? *worker.simulator : *simulator_, scorer_, context_, form_.form);
+          fits_[e] = own.fit(&effects_[e], baseline_);
+          evaluations[e] = own.evaluations;
+          if (!refit_plain) return;
+          Fitter in_plain(*worker.plain_simulator, scorer_, context_, plain);
+          Fit in_plain_form = in_plain.fit(&effects_[e], plain_baseline);
+          evaluations[e] += in_plain.evaluations;
+          if (in_plain_form.fit_residuals.squaredNorm() < fits_[e].fit_residuals.squaredNorm()) {
+            fits_[e] = std::move(in_plain_form);
+          }
+        },
+        one_done);
+    for (int count : evaluations) simulations_ += count;
+  }
+
+  FitEvidence baseline_evidence() const override { return evidence_of(scorer_, baseline_, nullptr); }
+  FitEvidence effect_evidence(std::size_t e) const override { return evidence_of(scorer_, fits_[e], &effects_[e]); }
+  double noise_misfit() const override { return noise_rms_; }
+
+  // Residuals cluster by particle and axis.
+  std::vector<int> residual_clusters() const override {
+    const int dim = recording_.dimension;
+    std::vector<int> clusters = scorer_.fit_residual_particles();
+    for (std::size_t j = 0; j < clusters.size(); ++j) {
+      clusters[j] = clusters[j] * dim + static_cast<int>(j % static_cast<std::size_t>(dim));
+    }
+    return clusters;
+  }
+
+  Candidate candidate(std::size_t e, const RankedEffect& ranked, double deff) const override {
+    const Fit& f = fits_[e];
     Candidate c;
-    c.effect = effects[r.index].name;
+    c.effect = effects_[e].name;
     for (std::size_t p = 0; p < f.values.size(); ++p) {
-      c.parameters[effects[r.index].parameters[p].name] = f.values[p];
-      c.parameter_std[effects[r.index].parameters[p].name] = f.std[p] * std::sqrt(deff);
+      c.parameters[effects_[e].parameters[p].name] = f.values[p];
+      c.parameter_std[effects_[e].parameters[p].name] = f.std[p] * std::sqrt(deff);
     }
     c.parameters["msm_beta"] = f.beta;
     c.parameter_std["msm_beta"] = f.beta_std * std::sqrt(deff);
@@ -978,112 +791,96 @@ DiagnoseResult diagnose_recording(const Recording& recording, const DiagnoseOpti
       c.parameter_std["msm_alpha"] = f.alpha_std * std::sqrt(deff);
     }
     c.rms = f.score.held_rms();
-    c.bic = r.bic;
-    c.explained = r.explained;
-    out.candidates.push_back(c);
+    c.bic = ranked.bic;
+    c.explained = ranked.explained;
+    return c;
   }
 
-  const bool passes = !ranked.empty() && ranked.front().passes;
-  const Stability stability = passes ? selection_stability(scorer, baseline, fits, ranked) : Stability{};
-  const bool found = passes && stability.explains >= kStableShare;
-  if (passes) {
-    out.selection_stability = stability.explains;
-    if (stability.rival_share >= kRivalShare) out.runner_up = effects[stability.rival].name;
-  }
-  const std::vector<double> baseline_map = magnitudes(recording, baseline.simulated);
-  const double t0 = out.location.t_start;
-  const double t1 = out.location.t_end;
-  std::ostringstream where;
-  if (!out.location.particles.empty()) {
-    where << "particles " << id_list(out.location.particles) << " between t = " << number(t0) << " s and " << number(t1)
-          << " s";
-  }
-  if (found) {
-    const Ranked& best = ranked.front();
-    const Effect& effect = effects[best.index];
-    const Fit& f = fits[best.index];
-    out.verdict = "missing_physics";
-    out.effect = effect.name;
+  void explain_named(std::size_t e, Diagnosis& out) const override {
+    const Effect& effect = effects_[e];
+    const Fit& f = fits_[e];
+    const bool same_form = f.form.steps_per_frame == form_.form.steps_per_frame &&
+                           f.form.fit_alpha == form_.form.fit_alpha &&
+                           f.form.cluster_radius_factor == form_.form.cluster_radius_factor;
     out.augmented =
-        msm_model(f, f.form,
-                  f.form.steps_per_frame == form.form.steps_per_frame && f.form.fit_alpha == form.form.fit_alpha &&
-                          f.form.cluster_radius_factor == form.form.cluster_radius_factor
-                      ? form.reason
-                      : "the plain form fitted the effect better than the baseline's");
+        msm_model(f, f.form, same_form ? form_.reason : "the plain form fitted the effect better than the baseline's");
     for (const auto& [name, value] : out.candidates.front().parameters) out.augmented.parameters[name] = value;
     out.augmented.parameter_std = out.candidates.front().parameter_std;
     out.improvement = 1.0 - out.augmented.rms / out.baseline.rms;
+    const std::string where = where_words();
     std::ostringstream text;
-    text << "The elastic model misses " << (where.str().empty() ? std::string("the motion") : where.str()) << " by "
-         << number(out.baseline.rms) << " " << recording.length_unit << " rms (noise " << number(noise_rms) << "); "
+    text << "The elastic model misses " << (where.empty() ? std::string("the motion") : where) << " by "
+         << number(out.baseline.rms) << " " << recording_.length_unit << " rms (noise " << number(noise_rms_) << "); "
          << effect.physics << " explains it, cutting the held-out rms by " << number(100.0 * out.improvement)
-         << " % and moving msm_beta from " << number(baseline.beta) << " to " << number(f.beta) << ".";
-    if (effect.replaces_beta) text << " " << describe_region(context.patches, split_patches(context.patches, f.values));
-    const bool close_rival = ranked.size() > 1 && ranked[1].passes && ranked[1].bic - best.bic < 6.0;
-    if (!out.runner_up.empty() || close_rival) {
-      const std::string rival = !out.runner_up.empty() ? out.runner_up : effects[ranked[1].index].name;
-      if (out.runner_up.empty()) out.runner_up = rival;
-      text << " " << rival << " fits almost as well; " << effect.experiment << ".";
-    }
+         << " % and moving msm_beta from " << number(baseline_.beta) << " to " << number(f.beta) << ".";
+    if (effect.replaces_beta)
+      text << " " << describe_region(context_.patches, split_patches(context_.patches, f.values));
+    if (!out.runner_up.empty()) text << " " << out.runner_up << " fits almost as well; " << effect.experiment << ".";
     out.explanation = text.str();
-    result.evidence.simulated_augmented = f.simulated;
-  } else {
-    out.augmented = out.baseline;
-    out.improvement = 0;
-    // The best effect that improved the fit clearly without being named, and why not.
-    std::string unstable;
-    if (passes) {
-      unstable = " " + effects[ranked.front().index].name + " improves the fit on some held-out frames but not on " +
-                 number(100.0 * kStableShare) + " % of resamples of them (" + number(100.0 * stability.explains) +
-                 " %).";
-    } else {
-      for (const Ranked& r : ranked) {
-        if (!r.clear) continue;
-        unstable = " " + effects[r.index].name + " improves the held-out rms by " + number(100.0 * r.improvement) +
-                   " % but explains only " + number(100.0 * r.explained) +
-                   " % of the misfit beyond the noise: the rest is not a catalogued effect, or the model's form "
-                   "is off.";
-        break;
-      }
-    }
-    if (misfit >= kUnknownMisfit && !out.location.particles.empty()) {
-      out.verdict = "missing_physics";
-      out.effect = "unknown";
-      out.explanation = "The elastic model misses " + where.str() + " by " + number(out.baseline.rms) + " " +
-                        recording.length_unit + " rms, " + number(misfit) +
-                        " times the noise, and no catalogued effect explains it clearly." + unstable;
-    } else {
-      out.verdict = "consistent";
-      out.effect = "none";
-      out.explanation = "The elastic model explains the recording to within " + number(misfit) +
-                        " times the measurement noise on held-out frames; no added physics improves it clearly." +
-                        unstable;
-    }
-    result.evidence.simulated_augmented = baseline.simulated;
   }
 
-  DiagnosisEvidence& ev = result.evidence;
-  ev.dimension = dim;
-  ev.particle_count = n;
-  ev.length_unit = recording.length_unit;
-  ev.frame_times_s = recording.frame_times_s;
-  ev.held_out = scorer.held_out();
-  ev.observed = recording.positions;
-  ev.simulated_baseline = baseline.simulated;
-  ev.residual_baseline = baseline_map;
-  ev.residual_augmented = magnitudes(recording, ev.simulated_augmented);
-  ev.fixed = recording.fixed;
-  for (const DrivenWindow& w : recording.driven) ev.driven.push_back(w.id);
-  std::sort(ev.driven.begin(), ev.driven.end());
-  ev.driven.erase(std::unique(ev.driven.begin(), ev.driven.end()), ev.driven.end());
-  ev.signatures = signatures;
-  ev.signatures["misfit_over_noise"] = misfit;
-  int simulations = fitter.evaluations + plain_evaluations;
-  for (int count : effect_evaluations) simulations += count;
-  ev.signatures["simulations"] = simulations;
-  ev.signatures["design_effect"] = deff;
-  result.runtime_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  return result;
+  UnexplainedWords unexplained_words(const Diagnosis& out) const override {
+    UnexplainedWords w;
+    w.model = "The elastic model";
+    w.where = where_words();
+    w.size = number(out.baseline.rms) + " " + recording_.length_unit + " rms";
+    w.misfit_word = "rms";
+    return w;
+  }
+
+  void fill_evidence(bool named, std::size_t e, DiagnosisEvidence& evidence) const override {
+    fill_recording_evidence(recording_, scorer_.held_out(), evidence);
+    evidence.simulated_baseline = baseline_.simulated;
+    evidence.simulated_augmented = named ? fits_[e].simulated : baseline_.simulated;
+    evidence.residual_baseline = magnitudes(recording_, evidence.simulated_baseline);
+    evidence.residual_augmented = magnitudes(recording_, evidence.simulated_augmented);
+  }
+
+  int simulations() const override { return simulations_; }
+
+ private:
+  // Held-out blocks of about 0.1 s; every free, observed particle is compared.
+  static Scorer make_scorer(const Recording& recording, const DiagnoseOptions& options) {
+    const int block = holdout_block_frames(recording, options.holdout_block_frames, 1);
+    std::vector<unsigned char> pairs = compared_pairs(recording);
+    if (std::find(pairs.begin(), pairs.end(), 1) == pairs.end()) {
+      throw std::runtime_error("no particle is observed while free; nothing to compare the model with");
+    }
+    return Scorer(recording, std::move(pairs), interleaved_holdout(recording.frame_count(), block));
+  }
+
+  std::string where_words() const {
+    if (location_.particles.empty()) return "";
+    std::ostringstream where;
+    where << "particles " << id_list(location_.particles) << " between t = " << number(location_.t_start) << " s and "
+          << number(location_.t_end) << " s";
+    return where.str();
+  }
+
+  const Recording& recording_;
+  const DiagnoseOptions& options_;
+  Scorer scorer_;
+  double noise_std_ = 0;
+  double noise_rms_ = 0;
+  FormChoice form_;
+  MsmSetupOptions setup_;
+  std::unique_ptr<RecordingSimulator> simulator_;
+  EffectContext context_;
+  Fit baseline_;
+  Location location_;
+  std::vector<Effect> effects_;
+  std::vector<Fit> fits_;
+  int simulations_ = 0;
+};
+
+}  // namespace
+
+DiagnoseResult diagnose_recording(const Recording& recording, const DiagnoseOptions& options) {
+  if (options.model == "fem") return diagnose_recording_fem(recording, options);
+  if (options.model != "msm") throw std::runtime_error("model '" + options.model + "' is unknown; use msm or fem");
+  require_enough_frames(recording);
+  MsmDiagnosis model(recording, options);
+  return run_diagnosis(model, recording.name, options);
 }
 
 nlohmann::json diagnosis_json(const Diagnosis& d) {

@@ -25,17 +25,17 @@
 #include "pliant/host/parallel_fits.hpp"
 #include "pliant/host/diagnose/residual_field.hpp"
 #include "pliant/host/fem/cylinder_mesh.hpp"
-#include "pliant/host/fem/least_squares_fit.hpp"
+#include "pliant/host/diagnose/selection.hpp"
+#include "pliant/host/least_squares_fit.hpp"
+#include "engine.hpp"
+#include "words.hpp"
 
 namespace pliant::host {
 namespace {
 
-constexpr int kMinFrames = 10;
-constexpr double kMinImprovement = 0.3;     // held-out misfit must fall by 30 % ...
-constexpr double kMinBicGain = 10.0;        // ... with "very strong" evidence (Kass-Raftery) ...
-constexpr double kMinSignificance = 3.0;    // ... and a parameter 3 std from its null
-constexpr double kMinMisfit = 1.5;          // baseline held-out misfit / noise worth explaining
-constexpr double kUnknownMisfit = 5.0;      // unexplained misfit reported as `unknown`
+using words::id_list;
+using words::number;
+
 constexpr double kQuasiStaticRatio = 10.0;  // loading time / lowest period above which statics hold
 constexpr int kMaxSolvedFrames = 40;        // quasi-static: frames solved per simulation, at most about
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -43,30 +43,6 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 std::size_t at(int i) { return static_cast<std::size_t>(i); }
 std::size_t at(long i) { return static_cast<std::size_t>(i); }
-
-std::string number(double v) {
-  std::ostringstream out;
-  out.precision(3);
-  out << v;
-  return out.str();
-}
-
-std::string id_list(const std::vector<int>& ids) {
-  std::ostringstream out;
-  for (std::size_t i = 0; i < ids.size();) {
-    std::size_t j = i;
-    while (j + 1 < ids.size() && ids[j + 1] == ids[j] + 1) ++j;
-    if (i > 0) out << ", ";
-    out << ids[i];
-    if (j > i) out << "-" << ids[j];
-    i = j + 1;
-    if (i >= 12 && i < ids.size()) {
-      out << " and " << ids.size() - i << " more";
-      break;
-    }
-  }
-  return out.str();
-}
 
 // Pressure-like modulus in readable units.
 std::string modulus(double pa) {
@@ -173,6 +149,38 @@ class FemScorer {
     return s;
   }
 
+  /// Held-out whitened squared residuals and their scalar count per held-out block, in frame
+  /// order (what the block bootstrap of selection.hpp resamples).
+  std::vector<HeldBlock> held_blocks(const FemRun& run) const {
+    int block_count = 0;
+    const std::vector<int> block_of = held_block_of_frame(held_out_, block_count);
+    std::vector<HeldBlock> blocks(at(block_count));
+    const int n = recording_.particle_count;
+    auto add = [&](int frame, double squared, double std) {
+      if (block_of[at(frame)] < 0) return;
+      HeldBlock& b = blocks[at(block_of[at(frame)])];
+      b.rss += std::isfinite(squared) ? squared / (std * std) : 0.0;
+      b.count += 3;
+    };
+    for (long pair : pairs_) {
+      double squared = 0;
+      for (int d = 0; d < 3; ++d) {
+        const double r = run.positions[at(pair) * 3 + at(d)] - recording_.positions[at(pair) * 3 + at(d)];
+        squared += r * r;
+      }
+      add(static_cast<int>(pair / n), squared, position_std_);
+    }
+    for (int k : force_frames_) {
+      double squared = 0;
+      for (int d = 0; d < 3; ++d) {
+        const double r = run.force[at(k) * 3 + at(d)] - measured_force_[at(k) * 3 + at(d)];
+        squared += r * r;
+      }
+      add(k, squared, force_std_);
+    }
+    return blocks;
+  }
+
   /// Whitened fitting residuals in a fixed order (positions, then forces).
   Eigen::VectorXd fit_residuals(const FemRun& run) const {
     Eigen::VectorXd r(fit_count_);
@@ -234,143 +242,10 @@ struct FemFit {
   double youngs_std = kInf;
   FemRun run;
   FemScore score;
-  double bic = 0;
+  Eigen::VectorXd fit_residuals;  // whitened, FemScorer::fit_residuals order
+  std::vector<HeldBlock> held_blocks;
+  int fitted = 0;  // E and the effect's parameters
 };
-
-// Bounded Levenberg-Marquardt with a forward-difference Jacobian (p + 1 evaluations per
-// iteration, plus one per rejected trial), for fits where every evaluation is a simulation that
-// cannot be shared. Coordinates: the value, or its logarithm for log-scale parameters; bounds by
-// projection, a coordinate held at its bound while the gradient pushes outward. Fills values,
-// final_cost (half the sum of squares), standard_deviations (s^2 (J^T J)^-1 with
-// s^2 = rss / (m - p), NaN where J^T J is singular in that direction), iterations, evaluations.
-bool forward_levenberg_marquardt(const std::vector<fem::FitParameter>& parameters, int residual_count,
-                                 const fem::ResidualFunction& function, int max_iterations, fem::FitResult& result) {
-  const int p = static_cast<int>(parameters.size());
-  auto to_value = [&](int j, double z) { return parameters[at(j)].log_scale ? std::exp(z) : z; };
-  std::vector<double> lower(at(p)), upper(at(p)), z(at(p)), h(at(p));
-  for (int j = 0; j < p; ++j) {
-    const fem::FitParameter& fp = parameters[at(j)];
-    lower[at(j)] = fp.log_scale ? std::log(fp.lower) : fp.lower;
-    upper[at(j)] = fp.log_scale ? std::log(fp.upper) : fp.upper;
-    z[at(j)] = std::clamp(fp.log_scale ? std::log(fp.initial) : fp.initial, lower[at(j)], upper[at(j)]);
-    h[at(j)] = 1e-3 * (fp.log_scale ? 1.0 : fp.upper - fp.lower);
-  }
-  int evaluations = 0;
-  auto evaluate = [&](const std::vector<double>& coordinates, Eigen::VectorXd& r) {
-    std::vector<double> values(at(p));
-    for (int j = 0; j < p; ++j) values[at(j)] = to_value(j, coordinates[at(j)]);
-    std::vector<double> residuals(at(residual_count), 0.0);
-    ++evaluations;
-    if (!function(values, residuals)) return false;
-    r = Eigen::Map<const Eigen::VectorXd>(residuals.data(), residual_count);
-    return r.allFinite();
-  };
-  auto jacobian_at = [&](const std::vector<double>& coordinates, const Eigen::VectorXd& r, Eigen::MatrixXd& jacobian) {
-    jacobian = Eigen::MatrixXd::Zero(residual_count, p);
-    for (int j = 0; j < p; ++j) {
-      std::vector<double> probe = coordinates;
-      const double step = probe[at(j)] + h[at(j)] <= upper[at(j)] ? h[at(j)] : -h[at(j)];
-      probe[at(j)] += step;
-      Eigen::VectorXd rp;
-      if (!evaluate(probe, rp)) return false;
-      jacobian.col(j) = (rp - r) / step;
-    }
-    return true;
-  };
-  Eigen::VectorXd r;
-  if (!evaluate(z, r)) return false;
-  double cost = r.squaredNorm();
-  double lambda = 1e-3;
-  Eigen::MatrixXd jacobian;
-  bool have_jacobian = false;
-  int iterations = 0;
-  for (; iterations < max_iterations; ++iterations) {
-    if (!jacobian_at(z, r, jacobian)) break;
-    have_jacobian = true;
-    const Eigen::VectorXd gradient = jacobian.transpose() * r;
-    std::vector<int> active;
-    for (int j = 0; j < p; ++j) {
-      if ((z[at(j)] <= lower[at(j)] && gradient(j) > 0) || (z[at(j)] >= upper[at(j)] && gradient(j) < 0)) continue;
-      if (jacobian.col(j).squaredNorm() > 0) active.push_back(j);
-    }
-    if (active.empty()) break;
-    const int m = static_cast<int>(active.size());
-    Eigen::MatrixXd normal(m, m);
-    Eigen::VectorXd g(m);
-    for (int a = 0; a < m; ++a) {
-      g(a) = gradient(active[at(a)]);
-      for (int b = 0; b < m; ++b) normal(a, b) = jacobian.col(active[at(a)]).dot(jacobian.col(active[at(b)]));
-    }
-    bool accepted = false;
-    double new_cost = cost;
-    for (int attempt = 0; attempt < 6 && !accepted; ++attempt) {
-      Eigen::MatrixXd damped = normal;
-      for (int a = 0; a < m; ++a) damped(a, a) += lambda * std::max(normal(a, a), 1e-30);
-      const Eigen::VectorXd delta = damped.ldlt().solve(-g);
-      std::vector<double> trial = z;
-      for (int a = 0; a < m; ++a) {
-        double& v = trial[at(active[at(a)])];
-        v = std::clamp(v + (std::isfinite(delta(a)) ? delta(a) : 0.0), lower[at(active[at(a)])],
-                       upper[at(active[at(a)])]);
-      }
-      if (trial == z) break;
-      Eigen::VectorXd rt;
-      if (evaluate(trial, rt) && rt.squaredNorm() < cost) {
-        accepted = true;
-        new_cost = rt.squaredNorm();
-        z = trial;
-        r = rt;
-        lambda = std::max(lambda / 4.0, 1e-9);
-      } else {
-        lambda *= 8.0;
-      }
-    }
-    if (!accepted) break;
-    const double gain = cost - new_cost;
-    cost = new_cost;
-    have_jacobian = false;
-    // A gain of 1e-4 of the cost moves a BIC by 1e-4 of the residual count: at that point the
-    // fit is settled as far as selection is concerned.
-    if (gain < 1e-4 * cost) {
-      ++iterations;
-      break;
-    }
-  }
-  if (!have_jacobian && !jacobian_at(z, r, jacobian)) jacobian = Eigen::MatrixXd();
-  result = fem::FitResult();
-  for (const fem::FitParameter& fp : parameters) result.names.push_back(fp.name);
-  for (int j = 0; j < p; ++j) result.values.push_back(to_value(j, z[at(j)]));
-  result.final_cost = 0.5 * cost;
-  result.iterations = iterations;
-  result.standard_deviations.assign(at(p), kNaN);
-  if (jacobian.rows() == residual_count) {
-    const double s2 = residual_count > p ? cost / (residual_count - p) : 0.0;
-    const Eigen::MatrixXd normal = jacobian.transpose() * jacobian;
-    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(normal);
-    const Eigen::VectorXd values = eigen.eigenvalues();
-    const double largest = values.cwiseAbs().maxCoeff();
-    Eigen::VectorXd inverse = Eigen::VectorXd::Zero(p);
-    std::vector<bool> undetermined(at(p), false);
-    for (int k = 0; k < p; ++k) {
-      if (largest > 0 && values(k) > 1e-12 * largest) {
-        inverse(k) = 1.0 / values(k);
-      } else {
-        for (int j = 0; j < p; ++j)
-          undetermined[at(j)] = undetermined[at(j)] || std::abs(eigen.eigenvectors()(j, k)) > 1e-6;
-      }
-    }
-    const Eigen::MatrixXd covariance =
-        s2 * eigen.eigenvectors() * inverse.asDiagonal() * eigen.eigenvectors().transpose();
-    for (int j = 0; j < p; ++j) {
-      if (undetermined[at(j)] || !(covariance(j, j) >= 0)) continue;
-      const double chain = parameters[at(j)].log_scale ? result.values[at(j)] : 1.0;
-      result.standard_deviations[at(j)] = chain * std::sqrt(covariance(j, j));
-    }
-  }
-  result.evaluations = evaluations;
-  result.converged = true;
-  return std::isfinite(cost);
-}
 
 class FemFitter {
  public:
@@ -488,10 +363,10 @@ class FemFitter {
     double best_cost = kInf;
     std::vector<double> best_values = physical(effect, seeds.front().u);
     double best_youngs = seeds.front().youngs;
-    fem::FitResult best_result;
+    FitResult best_result;
     bool have_result = false;
     for (std::size_t s = 0; s < starts; ++s) {
-      fem::FitResult result;
+      FitResult result;
       if (!levenberg_marquardt(effect, seeds[s].u, seeds[s].youngs, result)) continue;
       if (2.0 * result.final_cost < best_cost) {
         best_cost = 2.0 * result.final_cost;
@@ -509,8 +384,7 @@ class FemFitter {
   }
 
   // Final evaluation, uncertainties and BIC.
-  FemFit finish(const FemEffect* effect, const std::vector<double>& values, double youngs,
-                const fem::FitResult* result) {
+  FemFit finish(const FemEffect* effect, const std::vector<double>& values, double youngs, const FitResult* result) {
     FemFit f;
     const Evaluation ev = evaluate(effect, values, youngs, profiled(effect), true);
     f.ok = ev.ok;
@@ -545,7 +419,9 @@ class FemFitter {
       const double s2 = n > fitted ? rss / (n - fitted) : 0.0;
       if (normal > 0) f.youngs_std = std::sqrt(s2 / normal);
     }
-    f.bic = n > 0 && rss > 0 ? n * std::log(rss / n) + fitted * std::log(n) : 0.0;
+    f.fit_residuals = ev.residuals;
+    f.held_blocks = scorer_.held_blocks(ev.run);
+    f.fitted = static_cast<int>(fitted);
     return f;
   }
 
@@ -558,12 +434,11 @@ class FemFitter {
   int simulations = 0;
 
  private:
-  bool levenberg_marquardt(const FemEffect* effect, const std::vector<double>& u, double youngs,
-                           fem::FitResult& result) {
-    std::vector<fem::FitParameter> parameters;
+  bool levenberg_marquardt(const FemEffect* effect, const std::vector<double>& u, double youngs, FitResult& result) {
+    std::vector<FitParameter> parameters;
     for (std::size_t p = 0; p < effect->parameters.size(); ++p) {
       const EffectParameter& ep = effect->parameters[p];
-      fem::FitParameter fp;
+      FitParameter fp;
       fp.name = ep.name;
       fp.lower = ep.lower;
       fp.upper = ep.upper;
@@ -577,24 +452,54 @@ class FemFitter {
     const bool with_youngs = !profiled(effect);
     if (with_youngs) parameters.push_back({"youngs_modulus", youngs, youngs / 10.0, youngs * 10.0, true});
     const std::size_t count = effect->parameters.size();
-    const fem::ResidualFunction function = [&](const std::vector<double>& values, std::vector<double>& residuals) {
+    const ResidualFunction function = [&](const std::vector<double>& values, std::vector<double>& residuals) {
       const std::vector<double> effect_values(values.begin(), values.begin() + static_cast<long>(count));
       const Evaluation ev = evaluate(effect, effect_values, with_youngs ? values.back() : youngs, !with_youngs);
       if (!ev.ok || ev.residuals.size() != static_cast<Eigen::Index>(residuals.size())) return false;
       for (std::size_t i = 0; i < residuals.size(); ++i) residuals[i] = ev.residuals(static_cast<Eigen::Index>(i));
       return true;
     };
-    // Every evaluation is a simulation: a forward-difference LM (p + 1 simulations per
-    // iteration) with a small iteration budget, rather than fit_least_squares' central
-    // differences (2p + 1).
-    return forward_levenberg_marquardt(parameters, static_cast<int>(scorer_.fit_count()), function,
-                                       with_youngs ? 8 : 10, result);
+    // Every evaluation is a simulation: forward differences (p + 1 simulations per Jacobian)
+    // and a small iteration budget. A relative gain of 1e-4 moves a BIC by 1e-4 of the residual
+    // count: the fit is then settled as far as selection is concerned.
+    FitOptions options;
+    options.loss = RobustLoss::none;
+    options.central_differences = false;
+    options.difference_step = 1e-3;
+    options.max_iterations = with_youngs ? 8 : 10;
+    options.function_tolerance = 1e-4;
+    options.parameter_tolerance = 1e-6;
+    options.initial_damping = 1e-3;
+    options.projected_line_search = false;
+    try {
+      result = fit_least_squares(parameters, static_cast<int>(scorer_.fit_count()), function, options);
+    } catch (const std::exception&) {
+      return false;  // the model fails at the start: the grid point stays the fit
+    }
+    return std::isfinite(result.final_cost);
   }
 
   FemRecordingSimulator& simulator_;
   const FemScorer& scorer_;
   const FemEffectContext& context_;
 };
+
+// A fit as selection sees it (selection.hpp): E is a nuisance coordinate; an effect's
+// parameters are tested against their nulls. A fit that could not be simulated is never named.
+FitEvidence evidence_of(const FemFit& fit, const FemEffect* effect) {
+  FitEvidence evidence;
+  evidence.ok = fit.ok;
+  if (!fit.ok) return evidence;
+  evidence.fit_residuals = fit.fit_residuals;
+  evidence.fitted = fit.fitted;
+  evidence.held_blocks = fit.held_blocks;
+  evidence.values = fit.values;
+  evidence.std = fit.std;
+  for (std::size_t p = 0; effect != nullptr && p < effect->parameters.size(); ++p) {
+    evidence.nulls.push_back(effect->parameters[p].null_value);
+  }
+  return evidence;
+}
 
 // Fills NaN frames of a frame-major array (values_per_frame entries each) by linear
 // interpolation in time between the nearest frames that have values (held at the ends).
@@ -830,467 +735,457 @@ double estimate_force_noise_std(const Recording& recording) {
   return scaled.empty() ? 0.0 : 1.4826 * median(scaled);
 }
 
-DiagnoseResult diagnose_recording_fem(const Recording& recording, const DiagnoseOptions& options) {
-  const auto started = std::chrono::steady_clock::now();
-  const int frames = recording.frame_count();
-  const int n = recording.particle_count;
-  if (frames < kMinFrames) {
-    throw std::runtime_error("too few frames (" + std::to_string(frames) + "); diagnose needs at least " +
-                             std::to_string(kMinFrames));
-  }
-  if (options.fem_time != "auto" && options.fem_time != "quasi_static" && options.fem_time != "dynamic") {
-    throw std::runtime_error("fem_time must be auto, quasi_static or dynamic (got '" + options.fem_time + "')");
-  }
-  auto report = [&](const std::string& stage, int done, int total) {
-    if (options.progress) options.progress(stage, done, total);
-  };
-  const double duration = recording.frame_times_s.back() - recording.frame_times_s.front();
+namespace {
 
-  // Quasi-static frames solved: every `stride`-th.
-  const int stride = options.fem_frame_stride > 0 ? options.fem_frame_stride
-                                                  : std::max(1, (frames + kMaxSolvedFrames - 1) / kMaxSolvedFrames);
-  auto make_simulator = [&](FemTimeMode mode) {
-    try {
-      return std::make_unique<FemRecordingSimulator>(recording, mode, stride);
-    } catch (const std::invalid_argument& error) {
-      throw std::runtime_error(std::string("--model fem: ") + error.what());
-    }
-  };
-  FemTimeMode mode = options.fem_time == "dynamic" ? FemTimeMode::dynamic : FemTimeMode::quasi_static;
-  std::unique_ptr<FemRecordingSimulator> simulator = make_simulator(mode);
-
-  // Held-out blocks of about 0.1 s, but at most a sixth of the recording (a fast test of a few
-  // tenths of a second still holds out three blocks), at least 3 frames, a whole number of
-  // solved strides.
-  int block = options.holdout_block_frames;
-  if (block <= 0) {
-    const double rate = duration > 0 ? (frames - 1) / duration : 30.0;
-    block = std::max(3, std::min(static_cast<int>(std::lround(0.1 * rate)), frames / 6));
-  }
-  const int solved_stride = mode == FemTimeMode::quasi_static ? stride : 1;
-  if (solved_stride > 1) block = solved_stride * std::max(1, (block + solved_stride - 1) / solved_stride);
-  const std::vector<unsigned char> held_out = interleaved_holdout(frames, block);
-  // Fits only look at the fitting frames: quasi-static runs of effects without history solve
-  // only those (FemFitter::evaluate).
-  std::vector<unsigned char> fitting_frames(held_out.size());
-  for (std::size_t k = 0; k < held_out.size(); ++k) fitting_frames[k] = held_out[k] == 0 ? 1 : 0;
-  simulator->set_fitting_frames(fitting_frames);
-
-  // Noise floors.
-  double object_size = 0;
+// Object size: the largest extent of the rest shape over the axes (1 when it has none).
+double object_size(const Recording& recording) {
+  double size = 0;
   for (int d = 0; d < 3; ++d) {
     double lo = kInf;
     double hi = -kInf;
-    for (int i = 0; i < n; ++i) {
+    for (int i = 0; i < recording.particle_count; ++i) {
       lo = std::min(lo, recording.rest_positions[at(i) * 3 + at(d)]);
       hi = std::max(hi, recording.rest_positions[at(i) * 3 + at(d)]);
     }
-    object_size = std::max(object_size, hi - lo);
+    size = std::max(size, hi - lo);
   }
-  if (!(object_size > 0)) object_size = 1.0;
-  // Position noise from the tracks that are compared (observed and not driven): driven tracks
-  // may be exact (a programmed tool path, platen positions derived from a crosshead reading)
-  // and would pull the median of the noise floor to zero.
-  double position_noise = 0;
-  {
-    const std::vector<unsigned char> compared = compared_pairs(recording);
-    if (std::find(compared.begin(), compared.end(), 1) != compared.end()) {
-      Recording tracks;
-      tracks.dimension = 3;
-      tracks.particle_count = n;
-      tracks.frame_times_s = recording.frame_times_s;
-      tracks.positions = recording.positions;
-      for (std::size_t pair = 0; pair < compared.size(); ++pair) {
-        if (compared[pair] != 0) continue;
-        for (std::size_t d = 0; d < 3; ++d) tracks.positions[pair * 3 + d] = kNaN;
-      }
-      position_noise = estimate_noise_std(tracks);
-    }
+  return size > 0 ? size : 1.0;
+}
+
+// Position noise from the tracks that are compared (observed and not driven): driven tracks
+// may be exact (a programmed tool path, platen positions derived from a crosshead reading) and
+// would pull the median of the noise floor to zero.
+double compared_position_noise_std(const Recording& recording) {
+  const std::vector<unsigned char> compared = compared_pairs(recording);
+  if (std::find(compared.begin(), compared.end(), 1) == compared.end()) return 0.0;
+  Recording tracks;
+  tracks.dimension = 3;
+  tracks.particle_count = recording.particle_count;
+  tracks.frame_times_s = recording.frame_times_s;
+  tracks.positions = recording.positions;
+  for (std::size_t pair = 0; pair < compared.size(); ++pair) {
+    if (compared[pair] != 0) continue;
+    for (std::size_t d = 0; d < 3; ++d) tracks.positions[pair * 3 + d] = kNaN;
   }
-  const double position_std = std::max(position_noise, 1e-6 * object_size);
+  return estimate_noise_std(tracks);
+}
+
+double force_noise_floor(const Recording& recording) {
   double peak_force = 0;
   for (const WrenchSample& s : recording.wrench) {
     peak_force = std::max(
         peak_force, std::sqrt(s.force_n[0] * s.force_n[0] + s.force_n[1] * s.force_n[1] + s.force_n[2] * s.force_n[2]));
   }
-  const double force_std = std::max(estimate_force_noise_std(recording), 1e-6 * std::max(peak_force, 1.0));
+  return std::max(estimate_force_noise_std(recording), 1e-6 * std::max(peak_force, 1.0));
+}
 
-  auto build_scorer = [&](const FemRecordingSimulator& sim) {
-    return std::make_unique<FemScorer>(recording, sim, held_out, position_std, force_std);
-  };
-  std::unique_ptr<FemScorer> scorer = build_scorer(*simulator);
-  if (!scorer->positions_compared() && !scorer->force_compared()) {
-    throw std::runtime_error(
-        "no free node is observed and no wrench is measured at constrained nodes; nothing to compare the FEM with");
+// Heterogeneity's patches of elements: nodes in spatial patches, each element in the patch most
+// of its corners belong to (ties: the first corner's); the reference patch has the most volume.
+void describe_patches(const Recording& recording, FemEffectContext& context) {
+  const int n = recording.particle_count;
+  const std::vector<std::vector<int>> patches = spatial_patches(
+      recording.rest_positions, 3, std::max(6, (n - static_cast<int>(recording.fixed.size())) / 8), recording.fixed);
+  std::vector<int> node_patch(at(n), 0);
+  for (std::size_t p = 0; p < patches.size(); ++p) {
+    for (int id : patches[p]) node_patch[at(id)] = static_cast<int>(p);
   }
-  if (!(simulator->loading_time_s() < kInf) && !scorer->positions_compared()) {
-    throw std::runtime_error("nothing is driven or loaded; there is no deformation to diagnose");
-  }
-
-  // Baseline E, first quasi-statically; then the time rule.
-  report("baseline", 0, 1);
-  FemEffectContext context;
-  const double start_youngs =
-      simulator->declared_youngs_modulus_pa() > 0 ? simulator->declared_youngs_modulus_pa() : 1e5;
-  auto fit_baseline = [&](FemRecordingSimulator& sim, const FemScorer& sc, double youngs) {
-    FemFitter fitter(sim, sc, context);
-    FemFitter::Evaluation ev = fitter.profile(nullptr, {}, youngs);
-    if (!ev.ok) {
-      throw std::runtime_error("the FEM baseline cannot be simulated: " + ev.run.failure);
-    }
-    if (!fitter.profiled(nullptr)) {
-      // Bounded Levenberg-Marquardt on log E alone.
-      const double e0 = ev.youngs;
-      std::vector<fem::FitParameter> parameters{{"youngs_modulus", e0, e0 / 30.0, e0 * 30.0, true}};
-      const fem::ResidualFunction function = [&](const std::vector<double>& values, std::vector<double>& residuals) {
-        const FemFitter::Evaluation e = fitter.evaluate(nullptr, {}, values[0], false);
-        if (!e.ok) return false;
-        for (std::size_t i = 0; i < residuals.size(); ++i) residuals[i] = e.residuals(static_cast<Eigen::Index>(i));
-        return true;
-      };
-      fem::FitOptions fit_options;
-      fit_options.loss = fem::RobustLoss::none;
-      fit_options.max_iterations = 15;
-      fit_options.difference_step = 1e-3;
-      try {
-        const fem::FitResult result =
-            fem::fit_least_squares(parameters, static_cast<int>(sc.fit_count()), function, fit_options);
-        const FemFit f = fitter.finish(nullptr, {}, result.values[0], &result);
-        return std::make_pair(f, fitter.simulations);
-      } catch (const std::exception&) {
-        // fall through to the profiled value
+  context.patch_count = static_cast<int>(patches.size());
+  std::vector<double> volume(patches.size(), 0.0);
+  const TetMesh& mesh = *recording.mesh;
+  for (int e = 0; e < mesh.tet_count(); ++e) {
+    int best = node_patch[at(mesh.tetrahedra[at(e) * 4])];
+    int best_votes = 0;
+    for (int c = 0; c < 4; ++c) {
+      const int p = node_patch[at(mesh.tetrahedra[at(e) * 4 + at(c)])];
+      int votes = 0;
+      for (int c2 = 0; c2 < 4; ++c2) votes += node_patch[at(mesh.tetrahedra[at(e) * 4 + at(c2)])] == p ? 1 : 0;
+      if (votes > best_votes) {
+        best_votes = votes;
+        best = p;
       }
     }
-    FemFit f = fitter.finish(nullptr, {}, ev.youngs, nullptr);
-    return std::make_pair(f, fitter.simulations);
-  };
-  const std::pair<FemFit, int> first_fit = fit_baseline(*simulator, *scorer, start_youngs);
-  FemFit baseline = first_fit.first;
-  int simulations = first_fit.second;
-  const double lowest_period = simulator->lowest_period_s(baseline.youngs);
-  const double loading_time = simulator->loading_time_s();
-  // No finite period (every node constrained, or the modes cannot be computed): nothing can
-  // vibrate that statics would miss, so the run stays quasi-static.
-  if (options.fem_time == "auto" && std::isfinite(lowest_period) && loading_time < kQuasiStaticRatio * lowest_period) {
-    mode = FemTimeMode::dynamic;
-    simulator = make_simulator(mode);
-    simulator->set_fitting_frames(fitting_frames);
-    scorer = build_scorer(*simulator);
-    auto refit = fit_baseline(*simulator, *scorer, baseline.youngs);
-    baseline = refit.first;
-    simulations += refit.second;
+    context.element_patch.push_back(best);
+    volume[at(best)] += std::abs(tet_signed_volume(mesh, e));
   }
-  if (!baseline.ok) throw std::runtime_error("the FEM baseline cannot be simulated");
-  report("baseline", 1, 1);
+  context.reference_patch = static_cast<int>(std::max_element(volume.begin(), volume.end()) - volume.begin());
+}
 
-  DiagnoseResult result;
-  Diagnosis& out = result.diagnosis;
-  out.recording = recording.name;
-  const bool positions = scorer->positions_compared();
-  const bool forces = scorer->force_compared();
-  out.noise_rms = positions ? position_std * std::sqrt(3.0) : kNaN;
-  out.force_noise_rms = forces ? force_std * std::sqrt(3.0) : kNaN;
-  out.baseline.model = "fem";
-  out.baseline.parameters = {{"youngs_modulus", baseline.youngs},
-                             {"poisson_ratio", simulator->poisson_ratio()},
-                             {"density", simulator->density_kg_m3()}};
-  out.baseline.parameter_std = {{"youngs_modulus", baseline.youngs_std}};
-  out.baseline.rms = baseline.score.rms();
-  out.baseline.force_rms = baseline.score.force_rms();
-
-  // Locate.
-  const std::vector<unsigned char>& solved = simulator->solved();
-  ResidualField field;
-  if (positions) {
-    field = make_residual_field(recording.positions, baseline.run.positions, n, 3);
-    out.location = locate_mismatch(field, recording.frame_times_s, position_std);
-  } else {
-    out.location =
-        force_location(*scorer, baseline.run, recording.frame_times_s,
-                       std::vector<int>(recording.wrench_applied_to.begin(), recording.wrench_applied_to.end()));
-    std::sort(out.location.particles.begin(), out.location.particles.end());
-  }
-  std::map<std::string, double> signatures;
-  if (positions && solved_stride == 1 && mode == FemTimeMode::quasi_static) {
-    signatures =
-        residual_signatures(recording, fill_frames(baseline.run.positions, recording.frame_times_s, solved, at(n) * 3),
-                            field, out.location, position_std);
-  }
-  if (forces) signatures["force_load_sign_change"] = force_load_sign_change(*scorer, baseline.run);
-  signatures["quasi_static"] = mode == FemTimeMode::quasi_static ? 1.0 : 0.0;
-  signatures["lowest_period_s"] = lowest_period;
-  signatures["loading_time_s"] = loading_time;
-  signatures["frame_stride"] = mode == FemTimeMode::quasi_static ? stride : 1;
-
-  // Effect context.
-  context.quasi_static = mode == FemTimeMode::quasi_static;
-  context.force_measured = forces;
-  context.has_wrench = !recording.wrench.empty() && !recording.wrench_applied_to.empty();
-  context.positions_compared = positions;
-  context.unloads = unloads(recording);
-  context.duration_s = duration;
-  context.frame_interval_s = duration / std::max(1, (frames - 1) / (context.quasi_static ? stride : 1));
-  context.recording_interval_s = duration / std::max(1, frames - 1);
-  context.peak_strain = peak_strain(baseline.run, recording, solved);
-  context.lowest_omega_rad_s =
-      std::isfinite(lowest_period) && lowest_period > 0 ? 2.0 * 3.14159265358979323846 / lowest_period : 0.0;
-  if (positions) {
-    const std::vector<std::vector<int>> patches = spatial_patches(
-        recording.rest_positions, 3, std::max(6, (n - static_cast<int>(recording.fixed.size())) / 8), recording.fixed);
-    std::vector<int> node_patch(at(n), 0);
-    for (std::size_t p = 0; p < patches.size(); ++p) {
-      for (int id : patches[p]) node_patch[at(id)] = static_cast<int>(p);
-    }
-    context.patch_count = static_cast<int>(patches.size());
-    std::vector<double> volume(patches.size(), 0.0);
-    const TetMesh& mesh = *recording.mesh;
-    for (int e = 0; e < mesh.tet_count(); ++e) {
-      // The patch most of the element's corners belong to (ties: the first corner's).
-      int best = node_patch[at(mesh.tetrahedra[at(e) * 4])];
-      int best_votes = 0;
-      for (int c = 0; c < 4; ++c) {
-        const int p = node_patch[at(mesh.tetrahedra[at(e) * 4 + at(c)])];
-        int votes = 0;
-        for (int c2 = 0; c2 < 4; ++c2) votes += node_patch[at(mesh.tetrahedra[at(e) * 4 + at(c2)])] == p ? 1 : 0;
-        if (votes > best_votes) {
-          best_votes = votes;
-          best = p;
-        }
+// What a named effect's parameters mean, in a sentence ("" when there is nothing to add).
+std::string effect_detail(const FemEffect& effect, const FemFit& f, const FemEffectContext& context) {
+  std::ostringstream text;
+  if (effect.name == "stiffening") {
+    const double k = f.values[0];
+    const double eps = context.peak_strain;
+    text << " Stress grows faster than strain: the best single modulus is too stiff at small strain and too soft at "
+            "large strain; with k = "
+         << number(k) << " the modulus at the peak strain " << number(eps) << " is "
+         << number(std::exp(std::min(k * eps * eps, 12.0))) << " times its small-strain value.";
+  } else if (effect.name == "latency") {
+    const double tau = f.values[0];
+    text << " The wrench stream " << (tau >= 0 ? "lags" : "leads") << " the positions by " << number(std::abs(tau))
+         << " s.";
+  } else if (effect.name == "viscosity" && context.force_measured) {
+    text << " The force relaxes: the instantaneous modulus is " << number(1.0 + f.values[0])
+         << " times the long-term one, with time constant " << number(f.values[1]) << " s.";
+  } else if (effect.name == "gravity") {
+    text << " A body acceleration of (" << number(f.values[0]) << ", " << number(f.values[1]) << ", "
+         << number(f.values[2]) << ") m/s^2 acts that the recording does not declare.";
+  } else if (effect.name == "plasticity") {
+    text << " Above an equivalent strain of " << number(f.values[0]) << " the rest shape creeps at "
+         << number(f.values[1]) << " /s: a permanent set.";
+  } else if (effect.name == "heterogeneity") {
+    std::vector<std::string> parts;
+    std::size_t k = 0;
+    for (int p = 0; p < context.patch_count; ++p) {
+      if (p == context.reference_patch) continue;
+      const double factor = f.values[k];
+      const double s = f.std[k];
+      ++k;
+      if (std::isfinite(s) && std::abs(factor - 1.0) >= SelectionRules{}.min_significance * s) {
+        parts.push_back("patch " + std::to_string(p + 1) + " x" + number(factor));
       }
-      context.element_patch.push_back(best);
-      volume[at(best)] += std::abs(tet_signed_volume(mesh, e));
     }
-    context.reference_patch = static_cast<int>(std::max_element(volume.begin(), volume.end()) - volume.begin());
+    if (!parts.empty()) {
+      text << " Modulus relative to the largest patch:";
+      for (std::size_t i = 0; i < parts.size(); ++i) text << (i == 0 ? " " : ", ") << parts[i];
+      text << ".";
+    }
+  }
+  return text.str();
+}
+
+// The corotational linear FEM as a diagnosis model (engine.hpp).
+class FemDiagnosis final : public DiagnosisModel {
+ public:
+  FemDiagnosis(const Recording& recording, const DiagnoseOptions& options) : recording_(recording), options_(options) {
+    const int frames = recording.frame_count();
+    duration_ = recording.frame_times_s.back() - recording.frame_times_s.front();
+    // Quasi-static frames solved: every `stride`-th.
+    stride_ = options.fem_frame_stride > 0 ? options.fem_frame_stride
+                                           : std::max(1, (frames + kMaxSolvedFrames - 1) / kMaxSolvedFrames);
+    mode_ = options.fem_time == "dynamic" ? FemTimeMode::dynamic : FemTimeMode::quasi_static;
+    simulator_ = make_simulator(mode_);
+    // Held-out blocks of about 0.1 s, but at most a sixth of the recording (a fast test of a few
+    // tenths of a second still holds out three blocks), at least 3 frames, a whole number of
+    // solved strides.
+    int block = holdout_block_frames(recording, options.holdout_block_frames, 6);
+    const int solved_stride = mode_ == FemTimeMode::quasi_static ? stride_ : 1;
+    if (solved_stride > 1) block = solved_stride * std::max(1, (block + solved_stride - 1) / solved_stride);
+    held_out_ = interleaved_holdout(frames, block);
+    // Fits only look at the fitting frames: quasi-static runs of effects without history solve
+    // only those (FemFitter::evaluate).
+    fitting_frames_.resize(held_out_.size());
+    for (std::size_t k = 0; k < held_out_.size(); ++k) fitting_frames_[k] = held_out_[k] == 0 ? 1 : 0;
+    simulator_->set_fitting_frames(fitting_frames_);
+
+    position_std_ = std::max(compared_position_noise_std(recording), 1e-6 * object_size(recording));
+    force_std_ = force_noise_floor(recording);
+    scorer_ = std::make_unique<FemScorer>(recording, *simulator_, held_out_, position_std_, force_std_);
+    if (!scorer_->positions_compared() && !scorer_->force_compared()) {
+      throw std::runtime_error(
+          "no free node is observed and no wrench is measured at constrained nodes; nothing to compare the FEM with");
+    }
+    if (!(simulator_->loading_time_s() < kInf) && !scorer_->positions_compared()) {
+      throw std::runtime_error("nothing is driven or loaded; there is no deformation to diagnose");
+    }
   }
 
-  // Candidates.
-  const double misfit = baseline.score.chi();
+  // E, first quasi-statically; then the time rule: a loading faster than kQuasiStaticRatio
+  // lowest natural periods is simulated dynamically and E refitted.
+  void fit_baseline(Diagnosis& out) override {
+    const double start_youngs =
+        simulator_->declared_youngs_modulus_pa() > 0 ? simulator_->declared_youngs_modulus_pa() : 1e5;
+    baseline_ = fit_youngs(start_youngs);
+    lowest_period_ = simulator_->lowest_period_s(baseline_.youngs);
+    loading_time_ = simulator_->loading_time_s();
+    // No finite period (every node constrained, or the modes cannot be computed): nothing can
+    // vibrate that statics would miss, so the run stays quasi-static.
+    if (options_.fem_time == "auto" && std::isfinite(lowest_period_) &&
+        loading_time_ < kQuasiStaticRatio * lowest_period_) {
+      mode_ = FemTimeMode::dynamic;
+      simulator_ = make_simulator(mode_);
+      simulator_->set_fitting_frames(fitting_frames_);
+      scorer_ = std::make_unique<FemScorer>(recording_, *simulator_, held_out_, position_std_, force_std_);
+      baseline_ = fit_youngs(baseline_.youngs);
+    }
+    if (!baseline_.ok) throw std::runtime_error("the FEM baseline cannot be simulated");
+    positions_ = scorer_->positions_compared();
+    forces_ = scorer_->force_compared();
+    out.noise_rms = positions_ ? position_std_ * std::sqrt(3.0) : kNaN;
+    out.force_noise_rms = forces_ ? force_std_ * std::sqrt(3.0) : kNaN;
+    out.baseline.model = "fem";
+    out.baseline.parameters = {{"youngs_modulus", baseline_.youngs},
+                               {"poisson_ratio", simulator_->poisson_ratio()},
+                               {"density", simulator_->density_kg_m3()}};
+    out.baseline.parameter_std = {{"youngs_modulus", baseline_.youngs_std}};
+    out.baseline.rms = baseline_.score.rms();
+    out.baseline.force_rms = baseline_.score.force_rms();
+  }
+
+  std::map<std::string, double> locate(Diagnosis& out) override {
+    const int n = recording_.particle_count;
+    const std::vector<unsigned char>& solved = simulator_->solved();
+    const bool quasi_static = mode_ == FemTimeMode::quasi_static;
+    ResidualField field;
+    if (positions_) {
+      field = make_residual_field(recording_.positions, baseline_.run.positions, n, 3);
+      out.location = locate_mismatch(field, recording_.frame_times_s, position_std_);
+    } else {
+      out.location =
+          force_location(*scorer_, baseline_.run, recording_.frame_times_s,
+                         std::vector<int>(recording_.wrench_applied_to.begin(), recording_.wrench_applied_to.end()));
+      std::sort(out.location.particles.begin(), out.location.particles.end());
+    }
+    location_ = out.location;
+    std::map<std::string, double> signatures;
+    if (positions_ && stride_ == 1 && quasi_static) {
+      signatures = residual_signatures(
+          recording_, fill_frames(baseline_.run.positions, recording_.frame_times_s, solved, at(n) * 3), field,
+          out.location, position_std_);
+    }
+    if (forces_) signatures["force_load_sign_change"] = force_load_sign_change(*scorer_, baseline_.run);
+    signatures["quasi_static"] = quasi_static ? 1.0 : 0.0;
+    signatures["lowest_period_s"] = lowest_period_;
+    signatures["loading_time_s"] = loading_time_;
+    signatures["frame_stride"] = quasi_static ? stride_ : 1;
+    return signatures;
+  }
+
+  std::vector<std::string> catalogue() override {
+    const int frames = recording_.frame_count();
+    context_.quasi_static = mode_ == FemTimeMode::quasi_static;
+    context_.force_measured = forces_;
+    context_.has_wrench = !recording_.wrench.empty() && !recording_.wrench_applied_to.empty();
+    context_.positions_compared = positions_;
+    context_.unloads = unloads(recording_);
+    context_.duration_s = duration_;
+    context_.frame_interval_s = duration_ / std::max(1, (frames - 1) / (context_.quasi_static ? stride_ : 1));
+    context_.recording_interval_s = duration_ / std::max(1, frames - 1);
+    context_.peak_strain = peak_strain(baseline_.run, recording_, simulator_->solved());
+    context_.lowest_omega_rad_s =
+        std::isfinite(lowest_period_) && lowest_period_ > 0 ? 2.0 * 3.14159265358979323846 / lowest_period_ : 0.0;
+    if (positions_) describe_patches(recording_, context_);
+    effects_ = fem_effect_catalogue(context_);
+    std::vector<std::string> names;
+    for (const FemEffect& e : effects_) names.push_back(e.name);
+    return names;
+  }
+
   // Every effect is fitted independently, so the fits run on worker threads, each with its own
   // simulator (a simulator holds the model, solvers and a run cache: one per thread). The
   // result does not depend on the thread count.
-  const std::vector<FemEffect> effects = fem_effect_catalogue(context);
-  std::vector<FemFit> fits(effects.size());
-  std::vector<int> effect_simulations(effects.size(), 0);
-  {
-    int done = 0;
-    report("effects", 0, static_cast<int>(effects.size()));
+  void fit_effects(int threads, const std::function<void()>& one_done) override {
+    fits_.assign(effects_.size(), FemFit{});
+    std::vector<int> simulations(effects_.size(), 0);
     run_on_workers(
-        effects.size(), worker_count(effects.size(), options.threads),
+        effects_.size(), worker_count(effects_.size(), threads),
         [&](bool is_caller) {
           std::unique_ptr<FemRecordingSimulator> made;
           if (!is_caller) {
-            made = make_simulator(mode);
-            made->set_fitting_frames(fitting_frames);
+            made = make_simulator(mode_);
+            made->set_fitting_frames(fitting_frames_);
           }
           return made;
         },
         [&](std::unique_ptr<FemRecordingSimulator>& made, std::size_t e) {
-          FemRecordingSimulator& own = made ? *made : *simulator;
-          FemFitter fitter(own, *scorer, context);
-          fits[e] = fitter.fit(&effects[e], baseline.youngs);
-          effect_simulations[e] = fitter.simulations;
+          FemRecordingSimulator& own = made ? *made : *simulator_;
+          FemFitter fitter(own, *scorer_, context_);
+          fits_[e] = fitter.fit(&effects_[e], baseline_.youngs);
+          simulations[e] = fitter.simulations;
         },
-        [&]() { report("effects", ++done, static_cast<int>(effects.size())); });
+        one_done);
+    for (int count : simulations) simulations_ += count;
   }
-  for (int count : effect_simulations) simulations += count;
 
-  struct Ranked {
-    std::size_t index;
-    double significance;
-    double explained;  // share of the whitened misfit beyond noise removed
-    bool clear;        // passes every test but min_explained_share
-    bool passes;
-  };
-  std::vector<Ranked> ranked;
-  const double base_chi = baseline.score.chi();
-  for (std::size_t e = 0; e < effects.size(); ++e) {
-    const FemFit& f = fits[e];
-    if (!f.ok) continue;
-    double significance = 0;
-    for (std::size_t p = 0; p < f.values.size(); ++p) {
-      const double null_value = effects[e].parameters[p].null_value;
-      if (std::isfinite(null_value) && std::isfinite(f.std[p]) && f.std[p] > 0) {
-        significance = std::max(significance, std::abs(f.values[p] - null_value) / f.std[p]);
-      }
-    }
-    const double improvement = base_chi > 0 ? 1.0 - f.score.chi() / base_chi : 0.0;
-    // chi is whitened by the noise: a perfect model shows 1.
-    const double explained = explained_share(base_chi, f.score.chi(), 1.0);
-    const bool clear = misfit >= kMinMisfit && improvement >= kMinImprovement && baseline.bic - f.bic >= kMinBicGain &&
-                       significance >= kMinSignificance;
-    ranked.push_back({e, significance, explained, clear, clear && explained >= min_explained_share});
-  }
-  std::sort(ranked.begin(), ranked.end(), [&](const Ranked& a, const Ranked& b) {
-    if (a.passes != b.passes) return a.passes;
-    return fits[a.index].score.chi() < fits[b.index].score.chi();
-  });
-  for (const Ranked& r : ranked) {
-    const FemFit& f = fits[r.index];
+  FitEvidence baseline_evidence() const override { return evidence_of(baseline_, nullptr); }
+  FitEvidence effect_evidence(std::size_t e) const override { return evidence_of(fits_[e], &effects_[e]); }
+  double noise_misfit() const override { return 1.0; }  // whitened residuals
+
+  // The whitened residuals are taken as independent (design effect 1): force residuals belong
+  // to no particle, so per-particle clusters do not describe them.
+  std::vector<int> residual_clusters() const override { return {}; }
+
+  Candidate candidate(std::size_t e, const RankedEffect& ranked, double) const override {
+    const FemFit& f = fits_[e];
     Candidate c;
-    c.effect = effects[r.index].name;
+    c.effect = effects_[e].name;
     for (std::size_t p = 0; p < f.values.size(); ++p) {
-      c.parameters[effects[r.index].parameters[p].name] = f.values[p];
-      c.parameter_std[effects[r.index].parameters[p].name] = f.std[p];
+      c.parameters[effects_[e].parameters[p].name] = f.values[p];
+      c.parameter_std[effects_[e].parameters[p].name] = f.std[p];
     }
     c.parameters["youngs_modulus"] = f.youngs;
     c.parameter_std["youngs_modulus"] = f.youngs_std;
     c.rms = f.score.rms();
     c.force_rms = f.score.force_rms();
-    c.bic = f.bic;
-    c.explained = r.explained;
-    out.candidates.push_back(c);
+    c.bic = ranked.bic;
+    c.explained = ranked.explained;
+    return c;
   }
 
-  // Where, in words.
-  std::ostringstream where;
-  if (!out.location.particles.empty()) {
-    if (positions) {
-      where << "particles " << id_list(out.location.particles);
-    } else {
-      where << "the force on the " << out.location.particles.size() << " particles the wrench acts on";
-    }
-    where << " between t = " << number(out.location.t_start) << " s and " << number(out.location.t_end) << " s";
-  }
-  std::ostringstream size;
-  if (forces) {
-    size << number(out.baseline.force_rms) << " N rms (force noise " << number(out.force_noise_rms) << " N)";
-  }
-  if (positions) {
-    if (forces) size << " and ";
-    size << number(out.baseline.rms) << " m rms (noise " << number(out.noise_rms) << " m)";
-  }
-  const std::string misfit_kind = positions && forces ? "misfit" : (forces ? "force rms" : "rms");
-
-  const bool found = !ranked.empty() && ranked.front().passes;
-  FemRun augmented_run = baseline.run;
-  if (found) {
-    const Ranked& best = ranked.front();
-    const FemEffect& effect = effects[best.index];
-    const FemFit& f = fits[best.index];
-    out.verdict = "missing_physics";
-    out.effect = effect.name;
+  void explain_named(std::size_t e, Diagnosis& out) const override {
+    const FemEffect& effect = effects_[e];
+    const FemFit& f = fits_[e];
     out.augmented.model = "fem";
     out.augmented.parameters = out.baseline.parameters;
     out.augmented.parameter_std = out.candidates.front().parameter_std;
     for (const auto& [key, value] : out.candidates.front().parameters) out.augmented.parameters[key] = value;
     out.augmented.rms = f.score.rms();
     out.augmented.force_rms = f.score.force_rms();
-    out.improvement = 1.0 - f.score.chi() / base_chi;
+    out.improvement = 1.0 - f.score.chi() / baseline_.score.chi();
+    const std::string where = where_words();
     std::ostringstream text;
-    text << "The linear FEM (E " << modulus(baseline.youngs) << ") misses "
-         << (where.str().empty() ? std::string("the recording") : where.str()) << " by " << size.str() << "; "
-         << effect.physics << " explains it, cutting the held-out " << misfit_kind << " by "
-         << number(100.0 * out.improvement) << " % and moving E from " << modulus(baseline.youngs) << " to "
+    text << "The linear FEM (E " << modulus(baseline_.youngs) << ") misses "
+         << (where.empty() ? std::string("the recording") : where) << " by " << size_words(out) << "; "
+         << effect.physics << " explains it, cutting the held-out " << misfit_word() << " by "
+         << number(100.0 * out.improvement) << " % and moving E from " << modulus(baseline_.youngs) << " to "
          << modulus(f.youngs) << ".";
-    if (effect.name == "stiffening") {
-      const double k = f.values[0];
-      const double eps = context.peak_strain;
-      text << " Stress grows faster than strain: the best single modulus is too stiff at small strain and too soft at "
-              "large strain; with k = "
-           << number(k) << " the modulus at the peak strain " << number(eps) << " is "
-           << number(std::exp(std::min(k * eps * eps, 12.0))) << " times its small-strain value.";
-    } else if (effect.name == "latency") {
-      const double tau = f.values[0];
-      text << " The wrench stream " << (tau >= 0 ? "lags" : "leads") << " the positions by " << number(std::abs(tau))
-           << " s.";
-    } else if (effect.name == "viscosity" && context.force_measured) {
-      text << " The force relaxes: the instantaneous modulus is " << number(1.0 + f.values[0])
-           << " times the long-term one, with time constant " << number(f.values[1]) << " s.";
-    } else if (effect.name == "gravity") {
-      text << " A body acceleration of (" << number(f.values[0]) << ", " << number(f.values[1]) << ", "
-           << number(f.values[2]) << ") m/s^2 acts that the recording does not declare.";
-    } else if (effect.name == "plasticity") {
-      text << " Above an equivalent strain of " << number(f.values[0]) << " the rest shape creeps at "
-           << number(f.values[1]) << " /s: a permanent set.";
-    } else if (effect.name == "heterogeneity") {
-      std::vector<std::string> parts;
-      std::size_t k = 0;
-      for (int p = 0; p < context.patch_count; ++p) {
-        if (p == context.reference_patch) continue;
-        const double factor = f.values[k];
-        const double s = f.std[k];
-        ++k;
-        if (std::isfinite(s) && std::abs(factor - 1.0) >= kMinSignificance * s) {
-          parts.push_back("patch " + std::to_string(p + 1) + " x" + number(factor));
-        }
-      }
-      if (!parts.empty()) {
-        text << " Modulus relative to the largest patch:";
-        for (std::size_t i = 0; i < parts.size(); ++i) text << (i == 0 ? " " : ", ") << parts[i];
-        text << ".";
-      }
-    }
-    if (ranked.size() > 1 && ranked[1].passes && fits[ranked[1].index].bic - f.bic < 6.0) {
-      text << " " << effects[ranked[1].index].name << " fits almost as well; " << effect.experiment << ".";
-    }
+    text << effect_detail(effect, f, context_);
+    if (!out.runner_up.empty()) text << " " << out.runner_up << " fits almost as well; " << effect.experiment << ".";
     out.explanation = text.str();
-    augmented_run = f.run;
-  } else {
-    out.augmented = out.baseline;
-    out.improvement = 0;
-    // An effect that improved the fit clearly but left too much of the misfit: say so.
-    std::string partial;
-    for (const Ranked& r : ranked) {
-      if (!r.clear) continue;
-      partial = " " + effects[r.index].name + " improves the held-out " + misfit_kind + " by " +
-                number(100.0 * (1.0 - fits[r.index].score.chi() / base_chi)) + " % but explains only " +
-                number(100.0 * r.explained) +
-                " % of the misfit beyond the noise: the rest is not a catalogued effect, or the model's form is off "
-                "(on a coarse mesh, the mesh itself).";
-      break;
-    }
-    if (misfit >= kUnknownMisfit && !out.location.particles.empty()) {
-      out.verdict = "missing_physics";
-      out.effect = "unknown";
-      out.explanation = "The linear FEM misses " + where.str() + " by " + size.str() + ", " + number(misfit) +
-                        " times the noise, and no catalogued effect explains it clearly." + partial;
-    } else {
-      out.verdict = "consistent";
-      out.effect = "none";
-      out.explanation = "The linear FEM explains the recording to within " + number(misfit) +
-                        " times the measurement noise on held-out frames; no added physics improves it clearly." +
-                        partial;
-    }
   }
 
-  DiagnosisEvidence& ev = result.evidence;
-  ev.dimension = 3;
-  ev.particle_count = n;
-  ev.length_unit = recording.length_unit;
-  ev.frame_times_s = recording.frame_times_s;
-  ev.held_out = held_out;
-  ev.observed = recording.positions;
-  ev.simulated_baseline = fill_frames(baseline.run.positions, recording.frame_times_s, solved, at(n) * 3);
-  ev.simulated_augmented = fill_frames(augmented_run.positions, recording.frame_times_s, solved, at(n) * 3);
-  ev.residual_baseline = residual_magnitudes(make_residual_field(recording.positions, ev.simulated_baseline, n, 3));
-  ev.residual_augmented = residual_magnitudes(make_residual_field(recording.positions, ev.simulated_augmented, n, 3));
-  ev.fixed = recording.fixed;
-  for (const DrivenWindow& w : recording.driven) ev.driven.push_back(w.id);
-  std::sort(ev.driven.begin(), ev.driven.end());
-  ev.driven.erase(std::unique(ev.driven.begin(), ev.driven.end()), ev.driven.end());
-  if (forces) {
+  UnexplainedWords unexplained_words(const Diagnosis& out) const override {
+    UnexplainedWords w;
+    w.model = "The linear FEM";
+    w.where = where_words();
+    w.size = size_words(out);
+    w.misfit_word = misfit_word();
+    w.form_hint = " (on a coarse mesh, the mesh itself)";
+    return w;
+  }
+
+  void fill_evidence(bool named, std::size_t e, DiagnosisEvidence& ev) const override {
+    const int frames = recording_.frame_count();
+    const int n = recording_.particle_count;
+    const std::vector<unsigned char>& solved = simulator_->solved();
+    const FemRun& augmented = named ? fits_[e].run : baseline_.run;
+    fill_recording_evidence(recording_, held_out_, ev);
+    ev.simulated_baseline = fill_frames(baseline_.run.positions, recording_.frame_times_s, solved, at(n) * 3);
+    ev.simulated_augmented = fill_frames(augmented.positions, recording_.frame_times_s, solved, at(n) * 3);
+    ev.residual_baseline = residual_magnitudes(make_residual_field(recording_.positions, ev.simulated_baseline, n, 3));
+    ev.residual_augmented =
+        residual_magnitudes(make_residual_field(recording_.positions, ev.simulated_augmented, n, 3));
+    if (!forces_) return;
     std::vector<unsigned char> force_known(at(frames), 0);
-    for (int k : scorer->force_frames()) force_known[at(k)] = 1;
+    for (int k : scorer_->force_frames()) force_known[at(k)] = 1;
     ev.force_observed.assign(at(frames) * 3, kNaN);
     for (int k = 0; k < frames; ++k) {
-      if (simulator->force_measured()[at(k)] == 0) continue;
-      for (int d = 0; d < 3; ++d) ev.force_observed[at(k) * 3 + at(d)] = scorer->measured_force()[at(k) * 3 + at(d)];
+      if (simulator_->force_measured()[at(k)] == 0) continue;
+      for (int d = 0; d < 3; ++d) ev.force_observed[at(k) * 3 + at(d)] = scorer_->measured_force()[at(k) * 3 + at(d)];
     }
-    ev.force_baseline = fill_frames(baseline.run.force, recording.frame_times_s, force_known, 3);
-    ev.force_augmented = fill_frames(augmented_run.force, recording.frame_times_s, force_known, 3);
+    ev.force_baseline = fill_frames(baseline_.run.force, recording_.frame_times_s, force_known, 3);
+    ev.force_augmented = fill_frames(augmented.force, recording_.frame_times_s, force_known, 3);
     for (int k = 0; k < frames; ++k) {
-      if (simulator->force_measured()[at(k)] != 0) continue;
+      if (simulator_->force_measured()[at(k)] != 0) continue;
       for (int d = 0; d < 3; ++d) {
         ev.force_baseline[at(k) * 3 + at(d)] = kNaN;
         ev.force_augmented[at(k) * 3 + at(d)] = kNaN;
       }
     }
   }
-  ev.signatures = signatures;
-  ev.signatures["misfit_over_noise"] = misfit;
-  ev.signatures["simulations"] = simulations;
-  result.runtime_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  return result;
+
+  int simulations() const override { return simulations_; }
+
+ private:
+  std::unique_ptr<FemRecordingSimulator> make_simulator(FemTimeMode mode) const {
+    try {
+      return std::make_unique<FemRecordingSimulator>(recording_, mode, stride_);
+    } catch (const std::invalid_argument& error) {
+      throw std::runtime_error(std::string("--model fem: ") + error.what());
+    }
+  }
+
+  // E alone: in closed form where the run allows it, else fit_least_squares on log E.
+  FemFit fit_youngs(double youngs) {
+    FemFitter fitter(*simulator_, *scorer_, context_);
+    const FemFitter::Evaluation ev = fitter.profile(nullptr, {}, youngs);
+    if (!ev.ok) throw std::runtime_error("the FEM baseline cannot be simulated: " + ev.run.failure);
+    FemFit fit;
+    bool fitted = false;
+    if (!fitter.profiled(nullptr)) {
+      const double e0 = ev.youngs;
+      const std::vector<FitParameter> parameters{{"youngs_modulus", e0, e0 / 30.0, e0 * 30.0, true}};
+      const ResidualFunction function = [&](const std::vector<double>& values, std::vector<double>& residuals) {
+        const FemFitter::Evaluation e = fitter.evaluate(nullptr, {}, values[0], false);
+        if (!e.ok) return false;
+        for (std::size_t i = 0; i < residuals.size(); ++i) residuals[i] = e.residuals(static_cast<Eigen::Index>(i));
+        return true;
+      };
+      FitOptions fit_options;
+      fit_options.loss = RobustLoss::none;
+      fit_options.max_iterations = 15;
+      fit_options.difference_step = 1e-3;
+      try {
+        const FitResult result =
+            fit_least_squares(parameters, static_cast<int>(scorer_->fit_count()), function, fit_options);
+        fit = fitter.finish(nullptr, {}, result.values[0], &result);
+        fitted = true;
+      } catch (const std::exception&) {
+        // the profiled value stands
+      }
+    }
+    if (!fitted) fit = fitter.finish(nullptr, {}, ev.youngs, nullptr);
+    simulations_ += fitter.simulations;
+    return fit;
+  }
+
+  std::string where_words() const {
+    if (location_.particles.empty()) return "";
+    std::ostringstream where;
+    if (positions_) {
+      where << "particles " << id_list(location_.particles);
+    } else {
+      where << "the force on the " << location_.particles.size() << " particles the wrench acts on";
+    }
+    where << " between t = " << number(location_.t_start) << " s and " << number(location_.t_end) << " s";
+    return where.str();
+  }
+
+  std::string size_words(const Diagnosis& out) const {
+    std::ostringstream size;
+    if (forces_)
+      size << number(out.baseline.force_rms) << " N rms (force noise " << number(out.force_noise_rms) << " N)";
+    if (positions_) {
+      if (forces_) size << " and ";
+      size << number(out.baseline.rms) << " m rms (noise " << number(out.noise_rms) << " m)";
+    }
+    return size.str();
+  }
+
+  std::string misfit_word() const { return positions_ && forces_ ? "misfit" : (forces_ ? "force rms" : "rms"); }
+
+  const Recording& recording_;
+  const DiagnoseOptions& options_;
+  double duration_ = 0;
+  int stride_ = 1;
+  FemTimeMode mode_ = FemTimeMode::quasi_static;
+  std::unique_ptr<FemRecordingSimulator> simulator_;
+  std::vector<unsigned char> held_out_;
+  std::vector<unsigned char> fitting_frames_;
+  double position_std_ = 0;
+  double force_std_ = 0;
+  std::unique_ptr<FemScorer> scorer_;
+  bool positions_ = false;
+  bool forces_ = false;
+  FemEffectContext context_;
+  FemFit baseline_;
+  double lowest_period_ = kInf;
+  double loading_time_ = kInf;
+  Location location_;
+  std::vector<FemEffect> effects_;
+  std::vector<FemFit> fits_;
+  int simulations_ = 0;
+};
+
+}  // namespace
+
+DiagnoseResult diagnose_recording_fem(const Recording& recording, const DiagnoseOptions& options) {
+  require_enough_frames(recording);
+  if (options.fem_time != "auto" && options.fem_time != "quasi_static" && options.fem_time != "dynamic") {
+    throw std::runtime_error("fem_time must be auto, quasi_static or dynamic (got '" + options.fem_time + "')");
+  }
+  FemDiagnosis model(recording, options);
+  return run_diagnosis(model, recording.name, options);
 }
 
 }  // namespace pliant::host

@@ -1,4 +1,4 @@
-#include "pliant/host/fem/least_squares_fit.hpp"
+#include "pliant/host/least_squares_fit.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 
 #include <ceres/ceres.h>
 
-namespace pliant::host::fem {
+namespace pliant::host {
 namespace {
 
 // The optimiser's coordinates: log(value) for log-scale parameters, value otherwise.
@@ -31,14 +31,115 @@ struct Coordinates {
 };
 
 // Runs the user's model for internal coordinates; counts calls; treats non-finite residuals
-// as a failed evaluation so one NaN never reaches the optimiser.
+// as a failed evaluation so one NaN never reaches the optimiser. Ceres asks for the same point
+// more than once (a trial point, then its Jacobian once accepted; our own evaluations before and
+// after the solve): the last few points asked for and the last Jacobian are remembered, so that a
+// model run is never repeated.
 class ModelEvaluator {
  public:
   ModelEvaluator(const Coordinates& coordinates, int residual_count, const ResidualFunction& f)
       : coordinates_(coordinates), residual_count_(residual_count), function_(f) {}
 
+  // Residuals at a point (remembered), the optimiser's trial points and the solution.
   bool evaluate(const double* internal, std::vector<double>& residuals) const {
-    const int n = static_cast<int>(coordinates_.parameters->size());
+    const std::vector<double> point(internal, internal + parameter_count());
+    for (const Remembered& r : remembered_) {
+      if (r.point != point) continue;
+      residuals = r.residuals;
+      return r.ok;
+    }
+    const bool ok = run(internal, residuals);
+    if (remembered_.size() == kRemembered) remembered_.erase(remembered_.begin());
+    remembered_.push_back({point, residuals, ok});
+    return ok;
+  }
+
+  // Central differences in internal coordinates, one-sided at a bound (forward differences when
+  // !central: the plus side only, the minus side where there is no plus). Row-major m x n.
+  // Columns with `skip[j]` (held coordinates; may be empty) are left zero and cost nothing;
+  // columns taken before at the same point are reused.
+  bool jacobian(const double* internal, const std::vector<double>& at, double difference_step, bool central,
+                double* out, const std::vector<bool>& skip = {}) const {
+    const int n = parameter_count();
+    const std::vector<double> center(internal, internal + n);
+    for (int j = 0; j < n; ++j) {
+      std::vector<double> column;
+      const bool skipped = !skip.empty() && skip[static_cast<size_t>(j)];
+      if (!skipped && !remembered_column(center, j, difference_step, central, column)) {
+        if (!difference_column(internal, at, difference_step, central, j, column)) return false;
+        if (columns_.size() == kRememberedColumns * static_cast<size_t>(n)) columns_.erase(columns_.begin());
+        columns_.push_back({center, j, difference_step, central, column});
+      }
+      for (int i = 0; i < residual_count_; ++i) {
+        out[static_cast<size_t>(i) * static_cast<size_t>(n) + static_cast<size_t>(j)] =
+            skipped ? 0.0 : column[static_cast<size_t>(i)];
+      }
+    }
+    return true;
+  }
+
+  int evaluations() const { return evaluations_; }
+
+ private:
+  // The solution's Jacobian can be a few back: Ceres may take the Jacobian of trial points it
+  // then does not keep.
+  static constexpr std::size_t kRemembered = 6;
+  static constexpr std::size_t kRememberedColumns = 3;  // per parameter
+  struct Remembered {
+    std::vector<double> point;
+    std::vector<double> residuals;
+    bool ok = false;
+  };
+  struct RememberedColumn {
+    std::vector<double> center;
+    int j = 0;
+    double step = 0.0;
+    bool central = true;
+    std::vector<double> values;
+  };
+
+  int parameter_count() const { return static_cast<int>(coordinates_.parameters->size()); }
+
+  bool remembered_column(const std::vector<double>& center, int j, double step, bool central,
+                         std::vector<double>& column) const {
+    for (const RememberedColumn& c : columns_) {
+      if (c.j != j || c.step != step || c.central != central || c.center != center) continue;
+      column = c.values;
+      return true;
+    }
+    return false;
+  }
+
+  // Column j of the Jacobian by differences around `internal`, where the residuals are `at`.
+  bool difference_column(const double* internal, const std::vector<double>& at, double difference_step, bool central,
+                         int j, std::vector<double>& column) const {
+    const int n = parameter_count();
+    std::vector<double> shifted(internal, internal + n);
+    std::vector<double> plus, minus;
+    const double h = coordinates_.step(j, difference_step);
+    const double hi = std::min(internal[j] + h, coordinates_.internal_upper(j));
+    const double lo = std::max(internal[j] - h, coordinates_.internal_lower(j));
+    shifted[static_cast<size_t>(j)] = hi;
+    const bool has_plus = hi > internal[j] && run(shifted.data(), plus);
+    shifted[static_cast<size_t>(j)] = lo;
+    const bool has_minus = (central || !has_plus) && lo < internal[j] && run(shifted.data(), minus);
+    if (!has_plus && !has_minus) return false;
+    column.resize(static_cast<size_t>(residual_count_));
+    for (size_t i = 0; i < column.size(); ++i) {
+      if (has_plus && has_minus) {
+        column[i] = (plus[i] - minus[i]) / (hi - lo);
+      } else if (has_plus) {
+        column[i] = (plus[i] - at[i]) / (hi - internal[j]);
+      } else {
+        column[i] = (at[i] - minus[i]) / (internal[j] - lo);
+      }
+    }
+    return true;
+  }
+
+  // One call of the user's model.
+  bool run(const double* internal, std::vector<double>& residuals) const {
+    const int n = parameter_count();
     values_.resize(static_cast<size_t>(n));
     for (int j = 0; j < n; ++j) values_[static_cast<size_t>(j)] = coordinates_.to_value(j, internal[j]);
     residuals.assign(static_cast<size_t>(residual_count_), 0.0);
@@ -48,48 +149,13 @@ class ModelEvaluator {
     return std::all_of(residuals.begin(), residuals.end(), [](double r) { return std::isfinite(r); });
   }
 
-  // Central differences in internal coordinates, one-sided at a bound (forward differences when
-  // !central: the plus side only, the minus side where there is no plus). Row-major m x n.
-  bool jacobian(const double* internal, const std::vector<double>& at, double difference_step, bool central,
-                double* out) const {
-    const int n = static_cast<int>(coordinates_.parameters->size());
-    std::vector<double> shifted(internal, internal + n);
-    std::vector<double> plus, minus;
-    for (int j = 0; j < n; ++j) {
-      const double h = coordinates_.step(j, difference_step);
-      const double hi = std::min(internal[j] + h, coordinates_.internal_upper(j));
-      const double lo = std::max(internal[j] - h, coordinates_.internal_lower(j));
-      shifted[static_cast<size_t>(j)] = hi;
-      const bool has_plus = hi > internal[j] && evaluate(shifted.data(), plus);
-      shifted[static_cast<size_t>(j)] = lo;
-      const bool has_minus = (central || !has_plus) && lo < internal[j] && evaluate(shifted.data(), minus);
-      shifted[static_cast<size_t>(j)] = internal[j];
-      for (int i = 0; i < residual_count_; ++i) {
-        const size_t ii = static_cast<size_t>(i);
-        double d;
-        if (has_plus && has_minus) {
-          d = (plus[ii] - minus[ii]) / (hi - lo);
-        } else if (has_plus) {
-          d = (plus[ii] - at[ii]) / (hi - internal[j]);
-        } else if (has_minus) {
-          d = (at[ii] - minus[ii]) / (internal[j] - lo);
-        } else {
-          return false;
-        }
-        out[static_cast<size_t>(i) * static_cast<size_t>(n) + static_cast<size_t>(j)] = d;
-      }
-    }
-    return true;
-  }
-
-  int evaluations() const { return evaluations_; }
-
- private:
   const Coordinates& coordinates_;
   int residual_count_;
   const ResidualFunction& function_;
   mutable std::vector<double> values_;
   mutable int evaluations_ = 0;
+  mutable std::vector<Remembered> remembered_;
+  mutable std::vector<RememberedColumn> columns_;
 };
 
 // Weight d(rho)/d(s) at s = r^2 for the loss used in the pass (1 without a loss).
@@ -128,11 +194,12 @@ class ModelCost final : public ceres::CostFunction {
     loss_ = loss;
     scale_ = scale;
   }
+  void set_held(const std::vector<bool>& held) { held_ = held; }
 
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
     if (!model_.evaluate(parameters[0], at_)) return false;
     const bool want_jacobian = jacobians != nullptr && jacobians[0] != nullptr;
-    if (want_jacobian && !model_.jacobian(parameters[0], at_, difference_step_, central_, jacobians[0])) {
+    if (want_jacobian && !model_.jacobian(parameters[0], at_, difference_step_, central_, jacobians[0], held_)) {
       return false;
     }
     const size_t n = static_cast<size_t>(parameter_count_);
@@ -160,6 +227,7 @@ class ModelCost final : public ceres::CostFunction {
   bool central_;
   RobustLoss loss_ = RobustLoss::none;
   double scale_ = 1.0;
+  std::vector<bool> held_;
   mutable std::vector<double> at_;
 };
 
@@ -196,8 +264,11 @@ void check_problem(const std::vector<FitParameter>& parameters, int residual_cou
     if (!(std::isfinite(p.lower) && std::isfinite(p.upper) && std::isfinite(p.initial))) {
       throw std::invalid_argument("fit: parameter " + p.name + " has a non-finite bound or start");
     }
-    if (!(p.lower < p.initial && p.initial < p.upper)) {
-      throw std::invalid_argument("fit: parameter " + p.name + " must start strictly between its bounds");
+    if (!(p.lower < p.upper)) {
+      throw std::invalid_argument("fit: parameter " + p.name + " needs a lower bound below its upper bound");
+    }
+    if (!(p.lower <= p.initial && p.initial <= p.upper)) {
+      throw std::invalid_argument("fit: parameter " + p.name + " must start within its bounds");
     }
     if (p.log_scale && p.lower <= 0.0) {
       throw std::invalid_argument("fit: log-scale parameter " + p.name + " needs a positive lower bound");
@@ -208,41 +279,156 @@ void check_problem(const std::vector<FitParameter>& parameters, int residual_cou
 struct PassOutcome {
   int iterations = 0;
   bool converged = false;
+  bool reached_bound = false;  // stopped because a free coordinate reached a bound
   std::string message;
 };
 
+bool on_lower(const Coordinates& coords, const std::vector<double>& internal, int j) {
+  return internal[static_cast<size_t>(j)] <= coords.internal_lower(j);
+}
+bool on_upper(const Coordinates& coords, const std::vector<double>& internal, int j) {
+  return internal[static_cast<size_t>(j)] >= coords.internal_upper(j);
+}
+
+// Stops a pass when a free coordinate reaches a bound it was not on when the pass began, so that
+// the active set can be revised (solve). Reads the parameters Ceres updates every iteration.
+class BoundWatch final : public ceres::IterationCallback {
+ public:
+  BoundWatch(const std::vector<double>& internal, const Coordinates& coords, const std::vector<bool>& held)
+      : internal_(internal), coords_(coords), held_(held) {
+    for (int j = 0; j < static_cast<int>(internal.size()); ++j) {
+      started_on_bound_.push_back(on_lower(coords, internal, j) || on_upper(coords, internal, j));
+    }
+  }
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
+    if (summary.iteration == 0 || !summary.step_is_successful) return ceres::SOLVER_CONTINUE;
+    for (int j = 0; j < static_cast<int>(internal_.size()); ++j) {
+      const size_t jj = static_cast<size_t>(j);
+      if (held_[jj] || started_on_bound_[jj]) continue;
+      if (on_lower(coords_, internal_, j) || on_upper(coords_, internal_, j)) {
+        reached = true;
+        return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
+      }
+    }
+    return ceres::SOLVER_CONTINUE;
+  }
+  bool reached = false;
+
+ private:
+  const std::vector<double>& internal_;
+  const Coordinates& coords_;
+  const std::vector<bool>& held_;
+  std::vector<bool> started_on_bound_;
+};
+
+// One Ceres solve with the `held` coordinates constant, at most `max_iterations` iterations.
 PassOutcome run_pass(ModelCost& cost, std::vector<double>& internal, const Coordinates& coords, RobustLoss loss,
-                     double loss_scale, const FitOptions& options, int pass) {
+                     double loss_scale, const FitOptions& options, int pass, const std::vector<bool>& held,
+                     int max_iterations) {
   ceres::Problem::Options problem_options;
   problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(problem_options);
   cost.set_loss(loss, loss_scale);
+  cost.set_held(held);
   problem.AddResidualBlock(&cost, nullptr, internal.data());
   const int n = static_cast<int>(internal.size());
+  std::vector<int> constant;
   for (int j = 0; j < n; ++j) {
     problem.SetParameterLowerBound(internal.data(), j, coords.internal_lower(j));
     problem.SetParameterUpperBound(internal.data(), j, coords.internal_upper(j));
+    if (held[static_cast<size_t>(j)]) constant.push_back(j);
   }
+  if (!constant.empty()) problem.SetManifold(internal.data(), new ceres::SubsetManifold(n, constant));
   ceres::Solver::Options solver_options;
   solver_options.minimizer_type = ceres::TRUST_REGION;
   solver_options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
   solver_options.linear_solver_type = ceres::DENSE_QR;
-  solver_options.max_num_iterations = options.max_iterations;
+  solver_options.max_num_iterations = max_iterations;
+  solver_options.initial_trust_region_radius = 1.0 / options.initial_damping;
+  // Ceres' projected line search on bounded problems (FitOptions::projected_line_search).
+  solver_options.max_num_line_search_step_size_iterations = options.projected_line_search ? 20 : 0;
   solver_options.function_tolerance = options.function_tolerance;
   solver_options.parameter_tolerance = options.parameter_tolerance;
   solver_options.gradient_tolerance = 1e-14;
   solver_options.logging_type = ceres::SILENT;
   solver_options.minimizer_progress_to_stdout = false;
   solver_options.num_threads = 1;
-  ProgressCallback callback(options.on_iteration, pass);
-  solver_options.callbacks.push_back(&callback);
+  solver_options.update_state_every_iteration = true;
+  ProgressCallback progress(options.on_iteration, pass);
+  BoundWatch watch(internal, coords, held);
+  solver_options.callbacks.push_back(&progress);
+  solver_options.callbacks.push_back(&watch);
   ceres::Solver::Summary summary;
   ceres::Solve(solver_options, &problem, &summary);
+  cost.set_held({});
   PassOutcome outcome;
   outcome.iterations = static_cast<int>(summary.iterations.size());
   outcome.converged = summary.termination_type == ceres::CONVERGENCE;
+  outcome.reached_bound = watch.reached;
   outcome.message = summary.BriefReport();
   return outcome;
+}
+
+// Coordinates on a bound whose gradient (of the plain sum of squares) points out of the box.
+// Only their Jacobian columns are computed.
+std::vector<bool> outward_at_bound(const ModelEvaluator& model, const Coordinates& coords,
+                                   const std::vector<double>& internal, int residual_count, const FitOptions& options) {
+  const int n = static_cast<int>(internal.size());
+  std::vector<bool> skip(static_cast<size_t>(n), true);
+  bool any = false;
+  for (int j = 0; j < n; ++j) {
+    const bool bound = on_lower(coords, internal, j) || on_upper(coords, internal, j);
+    skip[static_cast<size_t>(j)] = !bound;
+    any = any || bound;
+  }
+  std::vector<bool> held(static_cast<size_t>(n), false);
+  std::vector<double> r;
+  if (!any || !model.evaluate(internal.data(), r)) return held;
+  std::vector<double> jacobian(static_cast<size_t>(residual_count) * static_cast<size_t>(n));
+  if (!model.jacobian(internal.data(), r, options.difference_step, options.central_differences, jacobian.data(),
+                      skip)) {
+    return held;
+  }
+  for (int j = 0; j < n; ++j) {
+    if (skip[static_cast<size_t>(j)]) continue;
+    double gradient = 0.0;
+    for (int i = 0; i < residual_count; ++i) {
+      gradient += jacobian[static_cast<size_t>(i) * static_cast<size_t>(n) + static_cast<size_t>(j)] *
+                  r[static_cast<size_t>(i)];
+    }
+    held[static_cast<size_t>(j)] =
+        (on_lower(coords, internal, j) && gradient > 0.0) || (on_upper(coords, internal, j) && gradient < 0.0);
+  }
+  return held;
+}
+
+// Bounded Levenberg-Marquardt with an active set: a coordinate on a bound whose gradient points
+// outwards is held there (Ceres' own projection would propose steps through the bound, see them
+// fail and shrink the trust region, many iterations for nothing). The set is revised when a
+// pass ends or a free coordinate reaches a bound; at most options.max_iterations in all.
+PassOutcome solve(ModelCost& cost, const ModelEvaluator& model, std::vector<double>& internal,
+                  const Coordinates& coords, int residual_count, RobustLoss loss, double loss_scale,
+                  const FitOptions& options, int pass) {
+  constexpr int kMaxRounds = 6;
+  PassOutcome total;
+  int remaining = options.max_iterations;
+  std::vector<bool> held = outward_at_bound(model, coords, internal, residual_count, options);
+  for (int round = 0; round < kMaxRounds && remaining > 0; ++round) {
+    if (std::all_of(held.begin(), held.end(), [](bool h) { return h; })) {
+      total.converged = true;
+      total.message = "every parameter is held at a bound by its gradient";
+      break;
+    }
+    const PassOutcome outcome = run_pass(cost, internal, coords, loss, loss_scale, options, pass, held, remaining);
+    total.iterations += outcome.iterations;
+    remaining -= std::max(outcome.iterations - 1, 1);
+    total.converged = outcome.converged || outcome.reached_bound;
+    total.message = outcome.message;
+    const std::vector<bool> next = outward_at_bound(model, coords, internal, residual_count, options);
+    if (!outcome.reached_bound && next == held) break;
+    held = next;
+  }
+  return total;
 }
 
 }  // namespace
@@ -250,6 +436,9 @@ PassOutcome run_pass(ModelCost& cost, std::vector<double>& internal, const Coord
 FitResult fit_least_squares(const std::vector<FitParameter>& parameters, int residual_count,
                             const ResidualFunction& residuals, const FitOptions& options) {
   check_problem(parameters, residual_count);
+  if (!(options.initial_damping > 0.0 && std::isfinite(options.initial_damping))) {
+    throw std::invalid_argument("fit: initial_damping must be positive and finite");
+  }
   const int n = static_cast<int>(parameters.size());
   const Coordinates coords{&parameters};
   ModelEvaluator model(coords, residual_count, residuals);
@@ -274,7 +463,7 @@ FitResult fit_least_squares(const std::vector<FitParameter>& parameters, int res
   if (loss != RobustLoss::none && scale <= 0.0) {
     // Automatic scale: least squares first, then robust passes, each with the scale taken
     // from the previous solution's residual scatter (MAD), until the scale settles.
-    outcome = run_pass(cost, internal, coords, RobustLoss::none, 0.0, options, pass++);
+    outcome = solve(cost, model, internal, coords, residual_count, RobustLoss::none, 0.0, options, pass++);
     result.iterations += outcome.iterations;
     for (int refinement = 0; refinement < 4; ++refinement) {
       if (!model.evaluate(internal.data(), r)) {
@@ -284,12 +473,12 @@ FitResult fit_least_squares(const std::vector<FitParameter>& parameters, int res
       if (!(next_scale > 0.0)) break;  // an exact fit: nothing to be robust about
       if (scale > 0.0 && std::abs(next_scale - scale) <= 0.05 * scale) break;
       scale = next_scale;
-      outcome = run_pass(cost, internal, coords, loss, scale, options, pass++);
+      outcome = solve(cost, model, internal, coords, residual_count, loss, scale, options, pass++);
       result.iterations += outcome.iterations;
     }
     if (!(scale > 0.0)) loss = RobustLoss::none;
   } else {
-    outcome = run_pass(cost, internal, coords, loss, scale, options, pass++);
+    outcome = solve(cost, model, internal, coords, residual_count, loss, scale, options, pass++);
     result.iterations += outcome.iterations;
   }
   result.converged = outcome.converged;
@@ -304,8 +493,8 @@ FitResult fit_least_squares(const std::vector<FitParameter>& parameters, int res
   const int m = residual_count;
   Eigen::MatrixXd jacobian(m, n);
   std::vector<double> row_major(static_cast<size_t>(m) * static_cast<size_t>(n));
-  const bool have_jacobian =
-      model.jacobian(internal.data(), r, options.difference_step, options.central_differences, row_major.data());
+  const bool have_jacobian = options.uncertainty && model.jacobian(internal.data(), r, options.difference_step,
+                                                                   options.central_differences, row_major.data());
   for (int i = 0; i < m; ++i) {
     for (int j = 0; j < n; ++j) jacobian(i, j) = row_major[static_cast<size_t>(i * n + j)];
   }
@@ -369,4 +558,4 @@ FitResult fit_least_squares(const std::vector<FitParameter>& parameters, int res
   return result;
 }
 
-}  // namespace pliant::host::fem
+}  // namespace pliant::host

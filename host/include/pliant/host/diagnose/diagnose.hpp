@@ -5,19 +5,22 @@
 // Procedure
 // 1. Frames are split into interleaved blocks; odd blocks are held out of every fit and every
 //    rms reported is measured on them.
-// 2. Baseline: msm_beta fitted on the fitting frames (grid + golden section), pinned supports,
-//    gravity only if declared, msm_alpha 1. Noise: measured from the recording alone.
+// 2. Baseline: the model form a user would fit (msm_alpha held or fitted, steps per frame,
+//    cluster radius: estimate's selection), then msm_beta (and msm_alpha) on the fitting frames.
+//    Noise: measured from the recording alone.
 // 3. Locate: residual field of the baseline, the particles and window where it concentrates,
 //    and the signature statistics.
 // 4. Every catalogued effect (effects.hpp) is refitted with msm_beta through the simulator: a
 //    grid over the parameters whose response is flat near the null, msm_beta profiled out at
-//    each grid point, then bounded Levenberg-Marquardt; uncertainty from a finite-difference
-//    Jacobian.
-// 5. Select: an effect is named only when its held-out rms improves clearly on the baseline,
-//    its BIC gain is >= 10, a parameter is >= 3 standard deviations from its null and the
-//    baseline misfit stands clearly above the noise floor; otherwise `consistent`.
-// options.model == "fem" runs the same procedure on the corotational linear FEM baseline
-// (fem_diagnose.hpp), which also compares forces and adds force_rms to the document.
+//    each grid point, then fit_least_squares (least_squares_fit.hpp, Ceres).
+// 5. Select (selection.hpp): an effect is named only when its held-out rms improves clearly on
+//    the baseline, its BIC gain is >= 10, a parameter is >= 3 standard deviations from its
+//    null, it explains three quarters of the misfit beyond the noise, the baseline misfit
+//    stands clearly above the noise floor and the choice holds under a block bootstrap of the
+//    held-out frames; otherwise `consistent` or `unknown`.
+// options.model == "fem" runs the same pipeline (the internal engine.hpp) on the corotational
+// linear FEM baseline (fem_diagnose.hpp), which also compares forces and adds force_rms to the
+// document.
 // Host code: allocates, throws std::runtime_error with one line when a recording cannot be
 // diagnosed (too few frames, nothing moves, nothing observed).
 #pragma once

@@ -82,7 +82,7 @@
 
 #include "pliant/host/fem/fem_recording.hpp"
 #include "pliant/host/fem/fem_solver.hpp"
-#include "pliant/host/fem/least_squares_fit.hpp"
+#include "pliant/host/least_squares_fit.hpp"
 #include "pliant/host/fem/material_map.hpp"
 
 namespace pliant::host::fem {

@@ -52,7 +52,7 @@
 
 #include "pliant/host/fem/fem_recording.hpp"
 #include "pliant/host/fem/fem_solver.hpp"
-#include "pliant/host/fem/least_squares_fit.hpp"
+#include "pliant/host/least_squares_fit.hpp"
 
 namespace pliant::host::fem {
 

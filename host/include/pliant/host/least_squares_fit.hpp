@@ -1,7 +1,8 @@
-// Bounded, robust nonlinear least squares for material estimation (Ceres Levenberg-Marquardt),
-// with parameter uncertainty. The FEM estimators (Young's modulus, Rayleigh damping, rest shape,
-// material maps) describe their parameters and hand over a residual function that runs the
-// model; this file owns everything about the optimisation itself.
+// Bounded, robust nonlinear least squares (Ceres Levenberg-Marquardt) with parameter
+// uncertainty: the one least-squares path of the host. The FEM estimators (Young's modulus,
+// Rayleigh damping, rest shape, material maps) and diagnosis (the MSM and FEM baselines and every
+// effect's fit) describe their parameters and hand over a residual function that runs the model;
+// this file owns everything about the optimisation itself.
 //
 // Host code: allocates, may throw std::invalid_argument on a malformed problem. Not real-time.
 #pragma once
@@ -12,9 +13,10 @@
 
 #include <Eigen/Dense>
 
-namespace pliant::host::fem {
+namespace pliant::host {
 
-/// One scalar unknown. `lower < initial < upper` (strictly inside: the optimiser starts there).
+/// One scalar unknown. `lower < upper` and `lower <= initial <= upper` (a start on a bound is
+/// allowed: its difference step then goes inwards).
 /// With `log_scale` the optimiser works on log(value): steps are relative, the value stays
 /// positive (lower must be > 0), and a start 10x off costs as many iterations as one 10x low.
 /// Use it for moduli and damping coefficients; use a linear scale for signed quantities.
@@ -59,6 +61,22 @@ struct FitOptions {
   /// halves the cost of each Jacobian for models where one evaluation is a long simulation; the
   /// O(step) error only perturbs the step direction and the covariance, not where the fit ends.
   bool central_differences = true;
+  /// Damping of the first Levenberg-Marquardt step, relative to the diagonal of J^T J (Ceres:
+  /// the inverse of the initial trust-region radius). Small: a Gauss-Newton first step; larger:
+  /// a shorter, gradient-like first step for models whose response is far from linear.
+  double initial_damping = 1e-4;
+  /// Ceres' projected line search after every trust-region step of a bounded problem (its
+  /// default). It rescues fits whose steps run into the bounds far from the solution (the FEM
+  /// trajectory fit from a start off in every parameter needs it), at a price: its cubic
+  /// interpolation asks for gradients, a whole finite-difference Jacobian per trial point. Off,
+  /// a step is projected onto the bounds and the trust region does the rest; diagnosis, which
+  /// starts every fit from a grid point near its solution, turns it off. Either way, a
+  /// coordinate on a bound whose gradient points outwards is held there (an active set).
+  bool projected_line_search = true;
+  /// Compute the covariance and standard deviations at the solution (one more Jacobian unless
+  /// the last one was taken there). Off for fits whose caller derives its own uncertainty: the
+  /// FitResult's covariance and standard_deviations are then NaN.
+  bool uncertainty = true;
   /// Called after every iteration with (pass, iteration, cost); may be empty.
   std::function<void(int, int, double)> on_iteration;
 };
@@ -78,6 +96,7 @@ struct FitResult {
   double residual_sigma = 0.0;
   int iterations = 0;          ///< over all passes
   int evaluations = 0;         ///< residual function calls, including Jacobian differences
+                               ///< (a point asked for again is answered from memory, not counted)
   bool converged = false;      ///< a tolerance was met (not the iteration limit)
   std::vector<bool> at_bound;  ///< per parameter: ended within 1e-6 (relative) of a bound
   std::string message;         ///< the optimiser's own summary line
@@ -89,4 +108,15 @@ struct FitResult {
 FitResult fit_least_squares(const std::vector<FitParameter>& parameters, int residual_count,
                             const ResidualFunction& residuals, const FitOptions& options = {});
 
-}  // namespace pliant::host::fem
+/// The names this file had when only the FEM estimators used it (pliant::host::fem::...);
+/// kept so that code written against them still builds.
+namespace fem {
+using pliant::host::fit_least_squares;
+using pliant::host::FitOptions;
+using pliant::host::FitParameter;
+using pliant::host::FitResult;
+using pliant::host::ResidualFunction;
+using pliant::host::RobustLoss;
+}  // namespace fem
+
+}  // namespace pliant::host
