@@ -263,7 +263,8 @@ TEST(StepeTableII, YoungsModulusFromTenthOneAndTenTimesWithinFivePercent) {
     EXPECT_TRUE(e.converged) << e.message;
     EXPECT_LT(relative_error(e.youngs_modulus_pa, kFoamPa), 0.05) << e.message;
     EXPECT_NEAR(e.position_noise_m, 0.5e-3, 0.1e-3);
-    EXPECT_LT(e.cpu_s, 10.0) << "STEPE case budget (the paper: 70-330 s)";
+    // Its time budget (10 s CPU; the paper: 70-330 s) is judged by bench/fem_estimate_bench, not
+    // here: a timed unit test fails on a loaded machine.
   }
 }
 

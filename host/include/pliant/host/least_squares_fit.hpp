@@ -4,6 +4,12 @@
 // effect's fit) describe their parameters and hand over a residual function that runs the model;
 // this file owns everything about the optimisation itself.
 //
+// Bounds: an active set. A coordinate on a bound whose gradient points out of the box is held
+// there (a Ceres SubsetManifold) and the others are solved; the set is revised when a solve ends
+// or a free coordinate reaches a bound. Every residual evaluation may be a long simulation: a
+// point asked for again, and a Jacobian column already taken at a point, are reused, never
+// recomputed (FitResult::evaluations counts the model runs made).
+//
 // Host code: allocates, may throw std::invalid_argument on a malformed problem. Not real-time.
 #pragma once
 
