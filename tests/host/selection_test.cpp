@@ -12,51 +12,21 @@
 
 #include <gtest/gtest.h>
 
+#include "synthetic_evidence.hpp"
+
 namespace {
 
 using pliant::host::FitEvidence;
 using pliant::host::held_block_of_frame;
-using pliant::host::HeldBlock;
 using pliant::host::not_named_sentence;
 using pliant::host::select_effect;
 using pliant::host::Selection;
 using pliant::host::unexplained_misfit_is_unknown;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr int kResiduals = 2000;
-constexpr int kBlocks = 20;
-constexpr long kPerBlock = 50;
-
-// Evidence of a fit whose residuals scatter with std `sigma` (fitting and held-out alike);
-// `offset` is added to the held-out residuals of the blocks listed in `biased_blocks`.
-FitEvidence fit_with(double sigma, int fitted, unsigned seed, std::vector<int> biased_blocks = {},
-                     double offset = 0.0) {
-  std::mt19937 random(seed);
-  std::normal_distribution<double> noise(0.0, sigma);
-  FitEvidence f;
-  f.fit_residuals.resize(kResiduals);
-  for (int i = 0; i < kResiduals; ++i) f.fit_residuals(i) = noise(random);
-  f.fitted = fitted;
-  for (int b = 0; b < kBlocks; ++b) {
-    HeldBlock block;
-    const bool biased = std::find(biased_blocks.begin(), biased_blocks.end(), b) != biased_blocks.end();
-    for (long i = 0; i < kPerBlock; ++i) {
-      const double r = noise(random) + (biased ? offset : 0.0);
-      block.rss += r * r;
-    }
-    block.count = kPerBlock;
-    f.held_blocks.push_back(block);
-  }
-  return f;
-}
-
-FitEvidence effect_with(double sigma, double value, double std, unsigned seed) {
-  FitEvidence f = fit_with(sigma, 2, seed);
-  f.values = {value};
-  f.std = {std};
-  f.nulls = {0.0};
-  return f;
-}
+constexpr int kResiduals = pliant::host::testing::kSyntheticResiduals;
+using pliant::host::testing::effect_with;
+using pliant::host::testing::fit_with;
 
 const std::vector<std::string> kNames{"first", "second", "third"};
 

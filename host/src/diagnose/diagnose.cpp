@@ -22,7 +22,7 @@
 #include "pliant/host/estimate.hpp"
 #include "pliant/host/least_squares_fit.hpp"
 #include "pliant/host/parallel_fits.hpp"
-#include "engine.hpp"
+#include "pliant/host/diagnose/engine.hpp"
 #include "words.hpp"
 
 namespace pliant::host {

@@ -1,4 +1,4 @@
-#include "engine.hpp"
+#include "pliant/host/diagnose/engine.hpp"
 
 #include <algorithm>
 #include <chrono>

@@ -27,7 +27,7 @@
 #include "pliant/host/fem/cylinder_mesh.hpp"
 #include "pliant/host/diagnose/selection.hpp"
 #include "pliant/host/least_squares_fit.hpp"
-#include "engine.hpp"
+#include "pliant/host/diagnose/engine.hpp"
 #include "words.hpp"
 
 namespace pliant::host {

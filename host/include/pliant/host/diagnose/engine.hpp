@@ -1,4 +1,4 @@
-// The diagnosis pipeline, written once (internal to diagnose/). A model -- the MSM
+// The diagnosis pipeline, written once. A model -- the MSM
 // (diagnose.cpp) or the FEM (fem_diagnose.cpp) -- is an adapter that fits its baseline and every
 // catalogued effect, scores them on held-out frames and words what it found; run_diagnosis
 // takes the steps in order (docs/diagnose.md):
@@ -10,8 +10,10 @@
 //   4. select     select_effect (selection.hpp)     on each fit's FitEvidence
 //   5. explain    candidates, verdict, explanation, evidence for the report
 //
-// An adapter is made for one recording and used once. Host code: allocates; the adapters throw
-// std::runtime_error with one line when the recording cannot be diagnosed.
+// An adapter is made for one recording and used once; run_diagnosis calls its methods in the
+// order above, each once, from the calling thread (fit_effects may use worker threads inside).
+// A new model becomes diagnosable by writing an adapter. Host code: allocates; the adapters
+// throw std::runtime_error with one line when the recording cannot be diagnosed.
 #pragma once
 
 #include <cstddef>
