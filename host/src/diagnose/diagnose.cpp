@@ -82,7 +82,17 @@ class Scorer {
   }
 
   /// The number of scalars fit_residuals returns.
-  int fit_residual_count() const { return static_cast<int>(fit_residual_particles().size()); }
+  int fit_residual_count() const {
+    long pairs = 0;
+    for (int k = 0; k < recording_.frame_count(); ++k) {
+      if (held_out_[static_cast<std::size_t>(k)] != 0) continue;
+      for (int i = 0; i < recording_.particle_count; ++i) {
+        pairs += pairs_[static_cast<std::size_t>(k) * static_cast<std::size_t>(recording_.particle_count) +
+                        static_cast<std::size_t>(i)];
+      }
+    }
+    return static_cast<int>(pairs * recording_.dimension);
+  }
 
   /// The particle of every scalar fit_residuals returns, in the same order.
   std::vector<int> fit_residual_particles() const {

@@ -12,10 +12,11 @@ namespace pliant::host {
 namespace {
 
 // 4. Every fit as selection sees it, and the decision.
-Selection select(const DiagnosisModel& model, const std::vector<std::string>& names, const SelectionRules& rules) {
+Selection select(const DiagnosisModel& model, const std::vector<std::string>& names,
+                 const std::vector<int>& residual_clusters, const SelectionRules& rules) {
   std::vector<FitEvidence> effects;
   for (std::size_t e = 0; e < names.size(); ++e) effects.push_back(model.effect_evidence(e));
-  return select_effect(model.baseline_evidence(), effects, model.noise_misfit(), model.residual_clusters(), rules);
+  return select_effect(model.baseline_evidence(), effects, model.noise_misfit(), residual_clusters, rules);
 }
 
 // 5. The verdict when nothing is named: `unknown` for a large located misfit, else
@@ -65,7 +66,8 @@ DiagnoseResult run_diagnosis(DiagnosisModel& model, const std::string& recording
   model.fit_effects(options.threads, [&]() { report("effects", ++done, total); });
 
   const SelectionRules rules;
-  const Selection selection = select(model, names, rules);
+  const std::vector<int> clusters = model.residual_clusters();
+  const Selection selection = select(model, names, clusters, rules);
   for (const RankedEffect& r : selection.ranked) {
     out.candidates.push_back(model.candidate(r.effect, r, selection.design_effect));
   }
@@ -86,7 +88,7 @@ DiagnoseResult run_diagnosis(DiagnosisModel& model, const std::string& recording
   evidence.signatures = signatures;
   evidence.signatures["misfit_over_noise"] = selection.misfit;
   evidence.signatures["simulations"] = model.simulations();
-  if (!model.residual_clusters().empty()) evidence.signatures["design_effect"] = selection.design_effect;
+  if (!clusters.empty()) evidence.signatures["design_effect"] = selection.design_effect;
   result.runtime_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;
 }
