@@ -38,6 +38,16 @@ std::string row(const std::string& key, const std::string& value) {
   return line + " " + value + "\n";
 }
 
+// How the model integrates the volume, and why (fem_model.hpp).
+std::string volumetric_words(const host::fem::FemMaterial& material) {
+  if (host::fem::resolved_volumetric(material) == host::fem::FemVolumetric::nodal_average) {
+    return "nodal_average (averaged nodal pressure: poisson_ratio " + num(material.poisson_ratio) +
+           " >= " + num(host::fem::kNodalAverageFromPoisson) + ", where the plain linear tetrahedron locks)";
+  }
+  return "element (poisson_ratio " + num(material.poisson_ratio) + " < " + num(host::fem::kNodalAverageFromPoisson) +
+         ")";
+}
+
 host::TetMesh mesh_with_moduli(const RefineReport& r) {
   host::TetMesh mesh = r.problem->mesh;
   const Eigen::VectorXd& e = r.outcome->element_youngs_modulus_pa;
@@ -75,6 +85,7 @@ nlohmann::json material_card(const RefineReport& r) {
   card["rms"] = number(o.rms_m);
   card["runtime_s"] = r.runtime_s;
   if (r.plan->estimator) card["estimator"] = to_string(*r.plan->estimator);
+  card["volumetric"] = host::fem::to_string(host::fem::resolved_volumetric(r.problem->material));
   nlohmann::json assumed = nlohmann::json::object();
   for (const auto& [name, value] : o.assumed) assumed[name] = value;
   card["assumed"] = assumed;
@@ -103,6 +114,7 @@ std::string refine_summary(const RefineReport& r) {
   }
   for (const auto& [name, value] : r.recording->material) text += row(name, num(value) + unit_of(name) + " (given)");
   for (const auto& [name, value] : o.assumed) text += row(name, num(value) + unit_of(name) + " (assumed)");
+  text += row("volumetric", volumetric_words(r.problem->material));
   if (o.has_map) {
     text += row("material_map", std::to_string(o.control_points_m.size()) + " control points, kernel width " +
                                     num(o.kernel_width_m) + " m");

@@ -4,9 +4,10 @@
 // Card keys beyond the spec (README "Refining with FEM"): "estimator" (force, reaction or
 // trajectory; absent when only the rest shape was estimated), "assumed" (values the model used
 // that the recording does not give: poisson_ratio 0.45, density 1000 kg/m^3, Rayleigh 0),
-// "material_map" adds "uncertainty" (1 sd per control point) and "kernel_width" (m, the
-// Gaussian width of material_map.hpp, needed to rebuild the per-element field), and
-// "diagnostics" (free_rms, counts, convergence, the estimator's own residuals).
+// "volumetric" (element or nodal_average: how the model integrates the volume, chosen from
+// poisson_ratio, see fem_model.hpp), "material_map" adds "uncertainty" (1 sd per control point) and "kernel_width" (m,
+// the Gaussian width of material_map.hpp, needed to rebuild the per-element field), and "diagnostics" (free_rms,
+// counts, convergence, the estimator's own residuals).
 #pragma once
 
 #include <string>

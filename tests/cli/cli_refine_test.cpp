@@ -63,10 +63,12 @@ void expect_card_follows_spec(const nlohmann::json& card, const nlohmann::json& 
   if (card.contains("rest_shape")) {
     EXPECT_TRUE(card.at("rest_shape").is_string());
   }
-  const std::set<std::string> allowed = {"format",      "version",      "recording",  "model", "parameters",
-                                         "uncertainty", "material_map", "rest_shape", "rms",   "runtime_s",
-                                         "estimator",   "assumed",      "diagnostics"};
+  const std::set<std::string> allowed = {"format",      "version",      "recording",  "model",      "parameters",
+                                         "uncertainty", "material_map", "rest_shape", "rms",        "runtime_s",
+                                         "estimator",   "assumed",      "volumetric", "diagnostics"};
   for (const auto& [key, value] : card.items()) EXPECT_EQ(allowed.count(key), 1u) << "undocumented key " << key;
+  ASSERT_TRUE(card.contains("volumetric"));
+  EXPECT_TRUE(card.at("volumetric") == "element" || card.at("volumetric") == "nodal_average") << card.at("volumetric");
 }
 
 double phantom_reference_pa(const std::string& material) {

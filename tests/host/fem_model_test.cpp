@@ -201,7 +201,9 @@ TEST(FemModel, UnitElementStiffnessMatchesVoigtOracle) {
       std::swap(mesh.tetrahedra[2], mesh.tetrahedra[3]);
       std::swap(corners[2], corners[3]);
     }
-    FemModel model(mesh, material(1.0, nu));
+    FemMaterial element_material = material(1.0, nu);
+    element_material.volumetric = fem::FemVolumetric::element;  // the plain element the oracle codes
+    FemModel model(mesh, element_material);
     const Eigen::Matrix<double, 12, 12> k = model.unit_element_stiffness(0);
     const Eigen::Matrix<double, 12, 12> oracle = voigt_stiffness(corners, 1.0, nu);
     EXPECT_LT((k - oracle).norm(), 1e-12 * oracle.norm()) << "nu " << nu;
@@ -218,6 +220,13 @@ TEST(FemModel, UnitElementStiffnessMatchesVoigtOracle) {
     model.set_youngs_modulus(3.5e4);
     const Eigen::MatrixXd assembled = Eigen::MatrixXd(fem::stiffness_matrix(model, model.rest_position_m()));
     EXPECT_LT((assembled - 3.5e4 * k).norm(), 1e-11 * assembled.norm());
+    // On a single tetrahedron every nodal average is the element's own value, so the averaged
+    // nodal pressure formulation must give the same matrix.
+    FemMaterial nodal_material = element_material;
+    nodal_material.volumetric = fem::FemVolumetric::nodal_average;
+    const FemModel nodal(mesh, nodal_material);
+    const Eigen::MatrixXd nodal_k = Eigen::MatrixXd(fem::stiffness_matrix(nodal, nodal.rest_position_m()));
+    EXPECT_LT((nodal_k - oracle).norm(), 1e-12 * oracle.norm()) << "nu " << nu;
   }
 }
 

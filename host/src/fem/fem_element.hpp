@@ -63,4 +63,32 @@ inline Eigen::Matrix3d rotated_stiffness_block(const Mat34& c, const Mat34& b, i
   return k;
 }
 
+/// Dilatation of an element, theta = tr(R^T F) - 3: the trace of its corotated strain. Its
+/// gradient with respect to corner a is exactly R b_a (the polar factor's derivative drops out of
+/// d tr(S) = R : dF).
+inline double dilatation(const Eigen::Matrix3d& f, const Eigen::Matrix3d& r) {
+  return (r.transpose() * f).trace() - 3.0;
+}
+
+/// Nodal pressures of the averaged-nodal-pressure formulation (fem_model.hpp) from one value per
+/// element (a dilatation, or its rate): p_a = kappa_a sum_{e at a} (V_e / 4) value_e / V_a.
+/// element_value: m entries; node_pressure: n entries, overwritten. Allocation-free.
+inline void nodal_pressure(const FemModel& model, const double* element_value, double* node_pressure) {
+  const auto& offsets = model.node_element_offsets();
+  const auto& stars = model.node_elements();
+  for (int a = 0; a < model.node_count(); ++a) {
+    double sum = 0;
+    for (int k = offsets[static_cast<std::size_t>(a)]; k < offsets[static_cast<std::size_t>(a) + 1]; ++k) {
+      const int e = stars[static_cast<std::size_t>(k)];
+      sum += 0.25 * model.element_volume_m3()[e] * element_value[e];
+    }
+    node_pressure[a] = model.node_bulk_modulus_pa()[a] * sum / model.node_volume_m3()[a];
+  }
+}
+
+/// The pressure an element feels: the mean of its corners' nodal pressures.
+inline double element_pressure(const std::array<int, 4>& nodes, const double* node_pressure) {
+  return 0.25 * (node_pressure[nodes[0]] + node_pressure[nodes[1]] + node_pressure[nodes[2]] + node_pressure[nodes[3]]);
+}
+
 }  // namespace pliant::host::fem::detail

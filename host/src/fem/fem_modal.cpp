@@ -26,16 +26,20 @@ class ShiftSolve {
  public:
   using Scalar = double;
   ShiftSolve(const FemModel& model, const Eigen::VectorXd& position, const std::vector<int>& free_index, int free_count)
-      : model_(model), position_(position), free_index_(free_index), free_count_(free_count) {
+      : model_(model), free_index_(free_index), free_count_(free_count), stiffness_(stiffness_matrix(model, position)) {
+    // The pattern of K (element pairs, and two element rings under the nodal volumetric
+    // formulation) on the free nodes.
     std::vector<std::vector<int>> adjacency(uz(free_count));
-    for (const auto& nodes : model.elements()) {
-      for (int a : nodes) {
-        for (int b : nodes) {
-          const int fa = free_index[uz(a)];
-          const int fb = free_index[uz(b)];
-          if (fa >= 0 && fb >= 0 && fa != fb) adjacency[uz(fa)].push_back(fb);
-        }
+    for (int col = 0; col < stiffness_.outerSize(); col += 3) {
+      for (Eigen::SparseMatrix<double>::InnerIterator it(stiffness_, col); it; ++it) {
+        const int fa = free_index[uz(static_cast<int>(it.row()) / 3)];
+        const int fb = free_index[uz(col / 3)];
+        if (fa >= 0 && fb >= 0 && fa != fb) adjacency[uz(fa)].push_back(fb);
       }
+    }
+    for (auto& list : adjacency) {
+      std::sort(list.begin(), list.end());
+      list.erase(std::unique(list.begin(), list.end()), list.end());
     }
     cholesky_.analyze(free_count, adjacency);
     scratch_.setZero(3 * free_count);
@@ -46,27 +50,20 @@ class ShiftSolve {
     cholesky_.set_zero();
     double* values = cholesky_.values();
     const Eigen::VectorXd& mass = model_.lumped_mass_kg();
-    for (int e = 0; e < model_.element_count(); ++e) {
-      const auto& nodes = model_.elements()[uz(e)];
-      const auto& b = model_.shape_gradients(e);
-      Eigen::Matrix3d f = Eigen::Matrix3d::Zero();
-      for (int a = 0; a < 4; ++a) f += position_.segment<3>(3 * nodes[uz(a)]) * b.col(a).transpose();
-      const detail::Mat34 c = polar_rotation(f) * b;
-      const double youngs = model_.youngs_modulus_pa()[e];
-      for (int a = 0; a < 4; ++a) {
-        for (int q = a; q < 4; ++q) {
-          const int fa = free_index_[uz(nodes[uz(a)])];
-          const int fq = free_index_[uz(nodes[uz(q)])];
-          if (fa < 0 || fq < 0) continue;
-          const Eigen::Matrix3d k =
-              detail::rotated_stiffness_block(c, b, a, q, model_.element_volume_m3()[e], youngs * model_.unit_mu(),
-                                              youngs * model_.unit_lambda()) /
-              std::sqrt(mass[nodes[uz(a)]] * mass[nodes[uz(q)]]);
-          const detail::BlockCholesky::Slot slot = cholesky_.slot(fa, fq);
-          for (int i = 0; i < 3; ++i) {
-            for (int j = 0; j < 3; ++j) values[slot.offset + i * slot.row_stride + j * slot.col_stride] += k(i, j);
-          }
-        }
+    // Lower triangle of M^-1/2 K M^-1/2 on the free nodes, entry by entry into its block slot.
+    for (int col = 0; col < stiffness_.outerSize(); ++col) {
+      const int node_col = col / 3;
+      const int fq = free_index_[uz(node_col)];
+      if (fq < 0) continue;
+      for (Eigen::SparseMatrix<double>::InnerIterator it(stiffness_, col); it; ++it) {
+        const int node_row = static_cast<int>(it.row()) / 3;
+        const int fa = free_index_[uz(node_row)];
+        if (fa < fq) continue;  // the slot of (fa, fq) with fa >= fq holds both triangles' blocks
+        const detail::BlockCholesky::Slot slot = cholesky_.slot(fa, fq);
+        const int i = static_cast<int>(it.row()) % 3;
+        const int j = col % 3;
+        values[slot.offset + i * slot.row_stride + j * slot.col_stride] +=
+            it.value() / std::sqrt(mass[node_row] * mass[node_col]);
       }
     }
     for (int i = 0; i < free_count_; ++i) {
@@ -86,9 +83,9 @@ class ShiftSolve {
 
  private:
   const FemModel& model_;
-  const Eigen::VectorXd& position_;
   const std::vector<int>& free_index_;
   int free_count_;
+  Eigen::SparseMatrix<double> stiffness_;   // K at the analysed positions, all 3n DOFs
   mutable detail::BlockCholesky cholesky_;  // solve() uses internal scratch
   mutable Eigen::VectorXd scratch_;
 };

@@ -76,7 +76,23 @@ FemModel::FemModel(const TetMesh& mesh, const FemMaterial& material) : material_
   }
   const Eigen::VectorXd rest = Eigen::Map<const Eigen::VectorXd>(mesh.points.data(), 3 * node_count_);
   precompute_geometry(rest);
+  build_node_stars();
+  material_.volumetric = resolved_volumetric(material_);
+  nodal_volumetric_ = material_.volumetric == FemVolumetric::nodal_average;
   update_lame();
+}
+
+void FemModel::build_node_stars() {
+  node_element_offsets_.assign(uz(node_count_) + 1, 0);
+  for (const auto& nodes : elements_) {
+    for (int node : nodes) ++node_element_offsets_[uz(node) + 1];
+  }
+  for (int a = 0; a < node_count_; ++a) node_element_offsets_[uz(a) + 1] += node_element_offsets_[uz(a)];
+  node_elements_.assign(uz(node_element_offsets_.back()), 0);
+  std::vector<int> fill(node_element_offsets_.begin(), node_element_offsets_.end() - 1);
+  for (int e = 0; e < element_count(); ++e) {
+    for (int node : elements_[uz(e)]) node_elements_[uz(fill[uz(node)]++)] = e;
+  }
 }
 
 void FemModel::precompute_geometry(const Eigen::VectorXd& rest) {
@@ -112,13 +128,39 @@ void FemModel::precompute_geometry(const Eigen::VectorXd& rest) {
   rest_ = rest;
   volume_ = std::move(volume);
   gradients_ = std::move(gradients);
+  node_volume_ = mass / material_.density_kg_m3;
   mass_ = std::move(mass);
+}
+
+void FemModel::update_node_bulk() {
+  node_bulk_.setZero(node_count_);
+  if (!nodal_volumetric_) return;
+  const double unit_kappa = unit_lambda_ + 2.0 * unit_mu_ / 3.0;
+  for (int e = 0; e < element_count(); ++e) {
+    for (int node : elements_[uz(e)]) node_bulk_[node] += 0.25 * volume_[e] * youngs_[e] * unit_kappa;
+  }
+  node_bulk_.array() /= node_volume_.array();
 }
 
 void FemModel::update_lame() {
   const double nu = material_.poisson_ratio;
   unit_mu_ = 1.0 / (2.0 * (1.0 + nu));
   unit_lambda_ = nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
+  update_node_bulk();
+}
+
+FemVolumetric resolved_volumetric(const FemMaterial& material) {
+  if (material.volumetric != FemVolumetric::automatic) return material.volumetric;
+  return material.poisson_ratio >= kNodalAverageFromPoisson ? FemVolumetric::nodal_average : FemVolumetric::element;
+}
+
+const char* to_string(FemVolumetric volumetric) {
+  switch (volumetric) {
+    case FemVolumetric::automatic: return "automatic";
+    case FemVolumetric::element: return "element";
+    case FemVolumetric::nodal_average: return "nodal_average";
+  }
+  return "unknown";
 }
 
 Eigen::Matrix<double, 12, 12> FemModel::unit_element_stiffness(int element) const {
@@ -128,7 +170,7 @@ Eigen::Matrix<double, 12, 12> FemModel::unit_element_stiffness(int element) cons
   for (int a = 0; a < 4; ++a) {
     for (int c = 0; c < 4; ++c) {
       k.block<3, 3>(3 * a, 3 * c) =
-          detail::rotated_stiffness_block(b, b, a, c, volume_[element], unit_mu_, unit_lambda_);
+          detail::rotated_stiffness_block(b, b, a, c, volume_[element], unit_mu_, unit_element_lambda());
     }
   }
   return k;
@@ -137,6 +179,7 @@ Eigen::Matrix<double, 12, 12> FemModel::unit_element_stiffness(int element) cons
 void FemModel::set_youngs_modulus(double youngs_modulus_pa) {
   check_modulus(youngs_modulus_pa, "global");
   youngs_.setConstant(youngs_modulus_pa);
+  update_node_bulk();
 }
 
 void FemModel::set_youngs_modulus(const Eigen::Ref<const Eigen::VectorXd>& per_element_pa) {
@@ -145,6 +188,7 @@ void FemModel::set_youngs_modulus(const Eigen::Ref<const Eigen::VectorXd>& per_e
   }
   for (Eigen::Index e = 0; e < per_element_pa.size(); ++e) check_modulus(per_element_pa[e], "per-element");
   youngs_ = per_element_pa;
+  update_node_bulk();
 }
 
 void FemModel::set_poisson_ratio(double poisson_ratio) {
@@ -183,6 +227,19 @@ void FemModel::set_gravity(const Eigen::Vector3d& gravity_m_s2) {
 
 void FemModel::set_rest_position(const Eigen::Ref<const Eigen::VectorXd>& rest_m) {
   precompute_geometry(rest_m);  // commits only after every element passed
+  update_node_bulk();
+}
+
+FemModel with_volumetric(const FemModel& model, FemVolumetric volumetric) {
+  TetMesh mesh;
+  mesh.points.assign(model.rest_position_m().data(), model.rest_position_m().data() + model.dof_count());
+  mesh.tetrahedra.reserve(4 * uz(model.element_count()));
+  for (const auto& nodes : model.elements()) mesh.tetrahedra.insert(mesh.tetrahedra.end(), nodes.begin(), nodes.end());
+  mesh.youngs_modulus.assign(model.youngs_modulus_pa().data(),
+                             model.youngs_modulus_pa().data() + model.element_count());
+  FemMaterial material = model.material();
+  material.volumetric = volumetric;
+  return FemModel(mesh, material);
 }
 
 Eigen::Matrix3d polar_rotation(const Eigen::Matrix3d& f) {
@@ -231,32 +288,111 @@ Eigen::Matrix3d deformation_gradient(const FemModel& model, int element,
   return detail::gather_gradient(position_m.data(), model.elements()[uz(element)], model.shape_gradients(element));
 }
 
+namespace {
+
+// Rotations of every element at x and, for the nodal formulation, the nodal pressures.
+struct ElementRotations {
+  std::vector<Eigen::Matrix3d> rotation;
+  std::vector<Eigen::Matrix3d> gradient;
+  Eigen::VectorXd dilatation;     // m entries, nodal formulation only
+  Eigen::VectorXd node_pressure;  // n entries, nodal formulation only
+};
+
+ElementRotations element_rotations(const FemModel& model, const Eigen::Ref<const Eigen::VectorXd>& position_m) {
+  if (position_m.size() != model.dof_count()) throw std::invalid_argument("FEM: positions must have 3n entries");
+  ElementRotations out;
+  const int m = model.element_count();
+  out.rotation.resize(uz(m));
+  out.gradient.resize(uz(m));
+  for (int e = 0; e < m; ++e) {
+    out.gradient[uz(e)] = detail::gather_gradient(position_m.data(), model.elements()[uz(e)], model.shape_gradients(e));
+    out.rotation[uz(e)] = polar_rotation(out.gradient[uz(e)]);
+  }
+  if (model.nodal_volumetric()) {
+    out.dilatation.resize(m);
+    for (int e = 0; e < m; ++e) out.dilatation[e] = detail::dilatation(out.gradient[uz(e)], out.rotation[uz(e)]);
+    out.node_pressure.resize(model.node_count());
+    detail::nodal_pressure(model, out.dilatation.data(), out.node_pressure.data());
+  }
+  return out;
+}
+
+// Sums the entries of a (node, vector) list that share a node; the list comes out sorted.
+void merge_by_node(std::vector<std::pair<int, Eigen::Vector3d>>& list) {
+  std::sort(list.begin(), list.end(), [](const auto& l, const auto& r) { return l.first < r.first; });
+  std::size_t out = 0;
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    if (out > 0 && list[out - 1].first == list[k].first) {
+      list[out - 1].second += list[k].second;
+    } else {
+      list[out++] = list[k];
+    }
+  }
+  list.resize(out);
+}
+
+// (kappa_a / V_a) g_a g_a^T per node, g_a = sum_{e at a} (V_e / 4) R_e b_e (3n, sparse).
+void add_volumetric_triplets(const FemModel& model, const ElementRotations& state,
+                             std::vector<Eigen::Triplet<double>>& triplets) {
+  std::vector<std::pair<int, Eigen::Vector3d>> g;
+  for (int a = 0; a < model.node_count(); ++a) {
+    g.clear();
+    for (int k = model.node_element_offsets()[uz(a)]; k < model.node_element_offsets()[uz(a) + 1]; ++k) {
+      const int e = model.node_elements()[uz(k)];
+      const detail::Mat34 c = state.rotation[uz(e)] * model.shape_gradients(e);
+      for (int q = 0; q < 4; ++q) {
+        g.emplace_back(model.elements()[uz(e)][uz(q)], 0.25 * model.element_volume_m3()[e] * c.col(q));
+      }
+    }
+    merge_by_node(g);
+    const double weight = model.node_bulk_modulus_pa()[a] / model.node_volume_m3()[a];
+    for (const auto& [i, gi] : g) {
+      for (const auto& [j, gj] : g) {
+        const Eigen::Matrix3d block = weight * gi * gj.transpose();
+        for (int r = 0; r < 3; ++r) {
+          for (int col = 0; col < 3; ++col) triplets.emplace_back(3 * i + r, 3 * j + col, block(r, col));
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+
 void internal_force(const FemModel& model, const Eigen::Ref<const Eigen::VectorXd>& position_m,
                     Eigen::VectorXd& force_n) {
-  if (position_m.size() != model.dof_count()) throw std::invalid_argument("FEM: positions must have 3n entries");
+  const ElementRotations state = element_rotations(model, position_m);
   force_n.setZero(model.dof_count());
   for (int e = 0; e < model.element_count(); ++e) {
     const auto& nodes = model.elements()[uz(e)];
     const auto& b = model.shape_gradients(e);
-    const Eigen::Matrix3d f = detail::gather_gradient(position_m.data(), nodes, b);
     const double youngs = model.youngs_modulus_pa()[e];
-    const Eigen::Matrix3d p =
-        detail::corotated_stress(f, polar_rotation(f), youngs * model.unit_mu(), youngs * model.unit_lambda(), nullptr);
+    const Eigen::Matrix3d& r = state.rotation[uz(e)];
+    Eigen::Matrix3d p = detail::corotated_stress(state.gradient[uz(e)], r, youngs * model.unit_mu(),
+                                                 youngs * model.unit_element_lambda(), nullptr);
+    if (model.nodal_volumetric()) p += detail::element_pressure(nodes, state.node_pressure.data()) * r;
     const detail::Mat34 corner = (-model.element_volume_m3()[e]) * (p * b);
     for (int a = 0; a < 4; ++a) force_n.segment<3>(3 * nodes[uz(a)]) += corner.col(a);
   }
 }
 
 double elastic_energy(const FemModel& model, const Eigen::Ref<const Eigen::VectorXd>& position_m) {
-  if (position_m.size() != model.dof_count()) throw std::invalid_argument("FEM: positions must have 3n entries");
+  const ElementRotations state = element_rotations(model, position_m);
   double energy = 0;
   for (int e = 0; e < model.element_count(); ++e) {
-    const Eigen::Matrix3d f =
-        detail::gather_gradient(position_m.data(), model.elements()[uz(e)], model.shape_gradients(e));
     const double youngs = model.youngs_modulus_pa()[e];
     double density = 0;
-    detail::corotated_stress(f, polar_rotation(f), youngs * model.unit_mu(), youngs * model.unit_lambda(), &density);
+    detail::corotated_stress(state.gradient[uz(e)], state.rotation[uz(e)], youngs * model.unit_mu(),
+                             youngs * model.unit_element_lambda(), &density);
     energy += model.element_volume_m3()[e] * density;
+  }
+  if (model.nodal_volumetric()) {
+    // sum_a V_a kappa_a theta_a^2 / 2 with p_a = kappa_a theta_a.
+    for (int a = 0; a < model.node_count(); ++a) {
+      const double p = state.node_pressure[a];
+      const double kappa = model.node_bulk_modulus_pa()[a];
+      if (kappa > 0) energy += 0.5 * model.node_volume_m3()[a] * p * p / kappa;
+    }
   }
   return energy;
 }
@@ -281,28 +417,48 @@ double gravity_energy(const FemModel& model, const Eigen::Ref<const Eigen::Vecto
 
 Eigen::SparseMatrix<double> stiffness_matrix(const FemModel& model,
                                              const Eigen::Ref<const Eigen::VectorXd>& position_m) {
-  if (position_m.size() != model.dof_count()) throw std::invalid_argument("FEM: positions must have 3n entries");
+  const ElementRotations state = element_rotations(model, position_m);
   std::vector<Eigen::Triplet<double>> triplets;
   triplets.reserve(uz(144 * model.element_count()));
   for (int e = 0; e < model.element_count(); ++e) {
     const auto& nodes = model.elements()[uz(e)];
     const auto& b = model.shape_gradients(e);
-    const Eigen::Matrix3d r = polar_rotation(detail::gather_gradient(position_m.data(), nodes, b));
-    const detail::Mat34 c = r * b;
+    const detail::Mat34 c = state.rotation[uz(e)] * b;
     const double youngs = model.youngs_modulus_pa()[e];
     for (int a = 0; a < 4; ++a) {
       for (int q = 0; q < 4; ++q) {
         const Eigen::Matrix3d k = detail::rotated_stiffness_block(
-            c, b, a, q, model.element_volume_m3()[e], youngs * model.unit_mu(), youngs * model.unit_lambda());
+            c, b, a, q, model.element_volume_m3()[e], youngs * model.unit_mu(), youngs * model.unit_element_lambda());
         for (int i = 0; i < 3; ++i) {
           for (int j = 0; j < 3; ++j) triplets.emplace_back(3 * nodes[uz(a)] + i, 3 * nodes[uz(q)] + j, k(i, j));
         }
       }
     }
   }
+  if (model.nodal_volumetric()) add_volumetric_triplets(model, state, triplets);
   Eigen::SparseMatrix<double> k(model.dof_count(), model.dof_count());
   k.setFromTriplets(triplets.begin(), triplets.end());
   return k;
+}
+
+Eigen::SparseMatrix<double> volumetric_stiffness_matrix(const FemModel& model,
+                                                        const Eigen::Ref<const Eigen::VectorXd>& position_m) {
+  const ElementRotations state = element_rotations(model, position_m);
+  std::vector<Eigen::Triplet<double>> triplets;
+  if (model.nodal_volumetric()) add_volumetric_triplets(model, state, triplets);
+  Eigen::SparseMatrix<double> k(model.dof_count(), model.dof_count());
+  k.setFromTriplets(triplets.begin(), triplets.end());
+  return k;
+}
+
+Eigen::VectorXd element_pressure_pa(const FemModel& model, const Eigen::Ref<const Eigen::VectorXd>& position_m) {
+  const ElementRotations state = element_rotations(model, position_m);
+  Eigen::VectorXd pressure = Eigen::VectorXd::Zero(model.element_count());
+  if (!model.nodal_volumetric()) return pressure;
+  for (int e = 0; e < model.element_count(); ++e) {
+    pressure[e] = detail::element_pressure(model.elements()[uz(e)], state.node_pressure.data());
+  }
+  return pressure;
 }
 
 }  // namespace pliant::host::fem

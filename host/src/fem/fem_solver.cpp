@@ -59,6 +59,24 @@ struct FemSolver::Impl {
   detail::BlockCholesky cholesky;
   double length_scale = 1;
 
+  // Averaged nodal pressure (model.nodal_volumetric() only). Node a's patch is the set of
+  // corners of its elements; its volumetric tangent (kappa_a / V_a) g_a g_a^T couples every pair
+  // of patch nodes. patch_nodes[patch_offsets[a] ..] lists them; star_corner_local holds, for
+  // each (element at a, corner), the corner's position in a's patch (4 per entry of
+  // model.node_elements()); pair_slots of node a (patch pairs i <= j, row-major over the
+  // upper triangle) start at patch_pair_offsets[a].
+  std::vector<int> patch_offsets;
+  std::vector<int> patch_nodes;
+  std::vector<int> star_corner_local;
+  std::vector<std::int64_t> patch_pair_offsets;
+  std::vector<PairSlot> patch_pair_slots;
+  std::vector<Eigen::Matrix3d> rotations;  // per element, from the last nodal_pressure_pass
+  Eigen::VectorXd dilatation;              // m: tr(R^T F) - 3
+  Eigen::VectorXd dilatation_rate;         // m: linearised dilatation of the vector w
+  Eigen::VectorXd node_pressure;           // n: kappa_a theta_a
+  Eigen::VectorXd node_pressure_rate;      // n: the same for dilatation_rate
+  Eigen::Matrix3Xd patch_gradient;         // 3 x (largest patch): g_a by patch node
+
   // Workspaces (3n unless noted).
   Eigen::VectorXd start;  // positions at the start of the substep
   Eigen::VectorXd x;
@@ -73,32 +91,89 @@ struct FemSolver::Impl {
 
   explicit Impl(const FemModel& m) : model(m) {}
 
+  // Rotations of every element at xs, and the nodal pressures of xs and (when wv != nullptr) of
+  // the linearised dilatation of wv. Nodal formulation only.
+  void nodal_pressure_pass(const double* xs, const double* wv) {
+    for (int e = 0; e < model.element_count(); ++e) {
+      const auto& nodes = model.elements()[uz(e)];
+      const detail::Mat34& b = model.shape_gradients(e);
+      const Eigen::Matrix3d f = detail::gather_gradient(xs, nodes, b);
+      rotations[uz(e)] = polar_rotation(f);
+      dilatation[e] = detail::dilatation(f, rotations[uz(e)]);
+      if (wv != nullptr)
+        dilatation_rate[e] = (rotations[uz(e)].transpose() * detail::gather_gradient(wv, nodes, b)).trace();
+    }
+    detail::nodal_pressure(model, dilatation.data(), node_pressure.data());
+    if (wv != nullptr) detail::nodal_pressure(model, dilatation_rate.data(), node_pressure_rate.data());
+  }
+
+  // Adds matrix_scale * sum_a (kappa_a / V_a) g_a g_a^T into the factor storage (free pairs),
+  // with the rotations of the last nodal_pressure_pass.
+  void assemble_nodal_volumetric(double matrix_scale) {
+    double* values = cholesky.values();
+    const auto& offsets = model.node_element_offsets();
+    const auto& stars = model.node_elements();
+    for (int a = 0; a < model.node_count(); ++a) {
+      const int patch_size = patch_offsets[uz(a) + 1] - patch_offsets[uz(a)];
+      patch_gradient.leftCols(patch_size).setZero();
+      for (int k = offsets[uz(a)]; k < offsets[uz(a) + 1]; ++k) {
+        const int e = stars[uz(k)];
+        const detail::Mat34 c = (0.25 * model.element_volume_m3()[e]) * (rotations[uz(e)] * model.shape_gradients(e));
+        for (int q = 0; q < 4; ++q) patch_gradient.col(star_corner_local[4 * uz(k) + uz(q)]) += c.col(q);
+      }
+      const double weight = matrix_scale * model.node_bulk_modulus_pa()[a] / model.node_volume_m3()[a];
+      const PairSlot* slot = patch_pair_slots.data() + patch_pair_offsets[uz(a)];
+      for (int i = 0; i < patch_size; ++i) {
+        for (int j = i; j < patch_size; ++j, ++slot) {
+          if (slot->offset < 0) continue;
+          const Eigen::Vector3d gr = weight * patch_gradient.col(slot->swap != 0 ? j : i);
+          const Eigen::Vector3d gc = patch_gradient.col(slot->swap != 0 ? i : j);
+          double* out = values + slot->offset;
+          for (int col = 0; col < 3; ++col, out += slot->ld) {
+            out[0] += gr[0] * gc[col];
+            out[1] += gr[1] * gc[col];
+            out[2] += gr[2] * gc[col];
+          }
+        }
+      }
+    }
+  }
+
   // One pass over the elements at positions xs: adds force_scale * (-f_int) to res, adds
   // beta_scale * K(xs) w when w != nullptr, and (if matrix_scale > 0) adds matrix_scale * K(xs)
   // into the factor storage (free-free blocks only).
   void element_pass(const double* xs, const double* wv, double beta_scale, double force_scale, double matrix_scale,
                     double* res) {
     const int m = model.element_count();
+    const bool nodal = model.nodal_volumetric();
     const double mu1 = model.unit_mu();
-    const double lambda1 = model.unit_lambda();
+    const double lambda1 = model.unit_element_lambda();
     double* values = cholesky.values();
+    if (nodal) nodal_pressure_pass(xs, wv);
     for (int e = 0; e < m; ++e) {
       const auto& nodes = model.elements()[uz(e)];
       const detail::Mat34& b = model.shape_gradients(e);
       const Eigen::Matrix3d f = detail::gather_gradient(xs, nodes, b);
-      const Eigen::Matrix3d r = polar_rotation(f);
+      const Eigen::Matrix3d r = nodal ? rotations[uz(e)] : polar_rotation(f);
       const double youngs = model.youngs_modulus_pa()[e];
       const double mu = youngs * mu1;
       const double lambda = youngs * lambda1;
       const double volume = model.element_volume_m3()[e];
-      const Eigen::Matrix3d p = detail::corotated_stress(f, r, mu, lambda, nullptr);
+      Eigen::Matrix3d p = detail::corotated_stress(f, r, mu, lambda, nullptr);
+      if (nodal) p += detail::element_pressure(nodes, node_pressure.data()) * r;
       const detail::Mat34 corner = (force_scale * volume) * (p * b);
       for (int a = 0; a < 4; ++a) {
         Eigen::Map<Eigen::Vector3d>(res + 3 * nodes[uz(a)]) += corner.col(a);
       }
       if (wv == nullptr && matrix_scale <= 0) continue;
       const detail::Mat34 c = r * b;
-      if (wv != nullptr) detail::add_rotated_stiffness_product(c, volume, mu, lambda, wv, nodes, beta_scale, res);
+      if (wv != nullptr) {
+        detail::add_rotated_stiffness_product(c, volume, mu, lambda, wv, nodes, beta_scale, res);
+        if (nodal) {
+          const double rate = beta_scale * volume * detail::element_pressure(nodes, node_pressure_rate.data());
+          for (int a = 0; a < 4; ++a) Eigen::Map<Eigen::Vector3d>(res + 3 * nodes[uz(a)]) += rate * c.col(a);
+        }
+      }
       if (matrix_scale <= 0) continue;
       const PairSlot* slots = pair_slots.data() + 10 * static_cast<std::size_t>(e);
       const double sv = matrix_scale * volume;
@@ -123,25 +198,30 @@ struct FemSolver::Impl {
         }
       }
     }
+    if (nodal && matrix_scale > 0) assemble_nodal_volumetric(matrix_scale);
   }
 
   // Internal force and K(xs) v at the constrained nodes only (boundary elements), into scratch:
   // scratch = -f_int + beta K v there.
   void boundary_pass(const double* xs, const double* v, double beta) {
     for (int node : constrained) scratch.segment<3>(3 * node).setZero();
+    const bool nodal = model.nodal_volumetric();
+    const bool damped = v != nullptr && beta > 0;
     const double mu1 = model.unit_mu();
-    const double lambda1 = model.unit_lambda();
+    const double lambda1 = model.unit_element_lambda();
+    if (nodal && !boundary_elements.empty()) nodal_pressure_pass(xs, damped ? v : nullptr);
     for (int e : boundary_elements) {
       const auto& nodes = model.elements()[uz(e)];
       const detail::Mat34& b = model.shape_gradients(e);
       const Eigen::Matrix3d f = detail::gather_gradient(xs, nodes, b);
-      const Eigen::Matrix3d r = polar_rotation(f);
+      const Eigen::Matrix3d r = nodal ? rotations[uz(e)] : polar_rotation(f);
       const double youngs = model.youngs_modulus_pa()[e];
       const double volume = model.element_volume_m3()[e];
-      const Eigen::Matrix3d p = detail::corotated_stress(f, r, youngs * mu1, youngs * lambda1, nullptr);
+      Eigen::Matrix3d p = detail::corotated_stress(f, r, youngs * mu1, youngs * lambda1, nullptr);
+      if (nodal) p += detail::element_pressure(nodes, node_pressure.data()) * r;
       const detail::Mat34 corner = volume * (p * b);
       Eigen::Matrix<double, 3, 4> damping = Eigen::Matrix<double, 3, 4>::Zero();
-      if (v != nullptr && beta > 0) {
+      if (damped) {
         const detail::Mat34 c = r * b;
         Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
         for (int a = 0; a < 4; ++a) {
@@ -149,6 +229,7 @@ struct FemSolver::Impl {
         }
         Eigen::Matrix3d s = youngs * mu1 * (h + h.transpose());
         s.diagonal().array() += youngs * lambda1 * h.trace();
+        if (nodal) s.diagonal().array() += detail::element_pressure(nodes, node_pressure_rate.data());
         damping = (beta * volume) * (s * c);
       }
       for (int a = 0; a < 4; ++a) {
@@ -185,6 +266,75 @@ struct FemSolver::Impl {
     cholesky.solve(rhs);
     return free_nodes.empty() ? 0.0 : rhs.cwiseAbs().maxCoeff();
   }
+  // Patches of the nodal formulation; adds the pairs of free patch nodes to `adjacency` (free
+  // numbering). Sizes the nodal workspaces.
+  void build_patches(std::vector<std::vector<int>>& adjacency) {
+    const auto& offsets = model.node_element_offsets();
+    const auto& stars = model.node_elements();
+    const int n = model.node_count();
+    patch_offsets.assign(uz(n) + 1, 0);
+    star_corner_local.assign(4 * stars.size(), 0);
+    std::vector<int> patch;
+    int largest = 0;
+    for (int a = 0; a < n; ++a) {
+      patch.clear();
+      for (int k = offsets[uz(a)]; k < offsets[uz(a) + 1]; ++k) {
+        for (int node : model.elements()[uz(stars[uz(k)])]) patch.push_back(node);
+      }
+      std::sort(patch.begin(), patch.end());
+      patch.erase(std::unique(patch.begin(), patch.end()), patch.end());
+      for (int k = offsets[uz(a)]; k < offsets[uz(a) + 1]; ++k) {
+        for (int q = 0; q < 4; ++q) {
+          const int node = model.elements()[uz(stars[uz(k)])][uz(q)];
+          star_corner_local[4 * uz(k) + uz(q)] =
+              static_cast<int>(std::lower_bound(patch.begin(), patch.end(), node) - patch.begin());
+        }
+      }
+      for (int i : patch) {
+        const int fi = free_index[uz(i)];
+        if (fi < 0) continue;
+        for (int j : patch) {
+          const int fj = free_index[uz(j)];
+          if (fj >= 0 && fj != fi) adjacency[uz(fi)].push_back(fj);
+        }
+      }
+      patch_nodes.insert(patch_nodes.end(), patch.begin(), patch.end());
+      patch_offsets[uz(a) + 1] = static_cast<int>(patch_nodes.size());
+      largest = std::max(largest, static_cast<int>(patch.size()));
+    }
+    patch_gradient.setZero(3, largest);
+    rotations.assign(uz(model.element_count()), Eigen::Matrix3d::Identity());
+    dilatation.setZero(model.element_count());
+    dilatation_rate.setZero(model.element_count());
+    node_pressure.setZero(n);
+    node_pressure_rate.setZero(n);
+  }
+
+  // Factor slots of every free pair of every patch (after the symbolic analysis).
+  void place_patch_slots() {
+    const int n = model.node_count();
+    patch_pair_offsets.assign(uz(n) + 1, 0);
+    for (int a = 0; a < n; ++a) {
+      const int begin = patch_offsets[uz(a)];
+      const int size = patch_offsets[uz(a) + 1] - begin;
+      for (int i = 0; i < size; ++i) {
+        for (int j = i; j < size; ++j) {
+          const int fi = free_index[uz(patch_nodes[uz(begin + i)])];
+          const int fj = free_index[uz(patch_nodes[uz(begin + j)])];
+          PairSlot out;
+          if (fi >= 0 && fj >= 0) {
+            const detail::BlockCholesky::Slot s = cholesky.slot(fi, fj);
+            out.offset = s.offset;
+            out.swap = s.row_stride != 1 ? 1 : 0;
+            out.ld = static_cast<std::int32_t>(out.swap != 0 ? s.row_stride : s.col_stride);
+          }
+          patch_pair_slots.push_back(out);
+        }
+      }
+      patch_pair_offsets[uz(a) + 1] = static_cast<std::int64_t>(patch_pair_slots.size());
+    }
+  }
+
   void place_constrained(Eigen::VectorXd& pos, const Eigen::VectorXd& driven_positions, const std::vector<int>& fixed,
                          const std::vector<int>& driven) const {
     for (int node : fixed) pos.segment<3>(3 * node) = model.rest_position_m().segment<3>(3 * node);
@@ -231,11 +381,13 @@ FemSolver::FemSolver(const FemModel& model, std::vector<int> fixed_nodes, std::v
     }
     if (boundary) im.boundary_elements.push_back(e);
   }
+  if (model.nodal_volumetric()) im.build_patches(adjacency);
   for (auto& list : adjacency) {
     std::sort(list.begin(), list.end());
     list.erase(std::unique(list.begin(), list.end()), list.end());
   }
   im.cholesky.analyze(nf, adjacency);
+  if (model.nodal_volumetric()) im.place_patch_slots();
   im.pair_slots.assign(10 * uz(model.element_count()), PairSlot{});
   for (int e = 0; e < model.element_count(); ++e) {
     const auto& nodes = model.elements()[uz(e)];

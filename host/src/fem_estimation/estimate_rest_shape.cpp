@@ -32,7 +32,8 @@ std::size_t uz(int i) { return static_cast<std::size_t>(i); }
 // internal_force and the lumped mass of fem_model.cpp; the residual is always evaluated with
 // those library functions, this copy only feeds the Jacobian, where a small mismatch would cost
 // convergence speed, never accuracy.
-Mat34 element_load(const Mat34& rest, const Mat34& x, double mu, double lambda, double density,
+// `pressure`: the nodal formulation's element pressure (Pa), held fixed; 0 for the element one.
+Mat34 element_load(const Mat34& rest, const Mat34& x, double mu, double lambda, double pressure, double density,
                    const Eigen::Vector3d& gravity) {
   Eigen::Matrix3d dm;
   Eigen::Matrix3d ds;
@@ -48,7 +49,7 @@ Mat34 element_load(const Mat34& rest, const Mat34& x, double mu, double lambda, 
   strain = 0.5 * (strain + strain.transpose());
   strain.diagonal().array() -= 1.0;
   Eigen::Matrix3d stress = 2.0 * mu * strain;
-  stress.diagonal().array() += lambda * strain.trace();
+  stress.diagonal().array() += lambda * strain.trace() + pressure;
   Mat34 b;
   b.rightCols<3>() = dm_inv.transpose();
   b.col(0) = -(b.col(1) + b.col(2) + b.col(3));
@@ -363,6 +364,49 @@ class RestShapeSolver {
     return r.allFinite();
   }
 
+  // dr/dX of the nodal dilatations: with f_vol = -sum_a p_a g_a, p_a = kappa_a (V_a theta_a) / V_a
+  // and d theta_e / dX_k = -S_e b_k (S = R^T F; from dF = -F dDm Dm^-1), the change of the
+  // pressures gives sum_a (kappa_a / V_a) g_a h_a^T with g_a = sum_{e at a} (V_e / 4) R_e b_e and
+  // h_a = sum_{e at a} (V_e / 4) S_e b_e (not symmetric). The change of g_a itself with X is left
+  // to the element blocks' held pressure.
+  void add_volumetric_tangent(std::vector<Eigen::Triplet<double>>& triplets) const {
+    const auto& offsets = model_.node_element_offsets();
+    const auto& stars = model_.node_elements();
+    std::vector<std::pair<int, Eigen::Matrix<double, 3, 2>>> gh;
+    for (int a = 0; a < model_.node_count(); ++a) {
+      gh.clear();
+      for (int k = offsets[uz(a)]; k < offsets[uz(a) + 1]; ++k) {
+        const int e = stars[uz(k)];
+        const auto& nodes = model_.elements()[uz(e)];
+        const Mat34& b = model_.shape_gradients(e);
+        const Eigen::Matrix3d f = deformation_gradient(model_, e, observed_);
+        const Eigen::Matrix3d r = polar_rotation(f);
+        const Eigen::Matrix3d stretch = r.transpose() * f;
+        const double quarter = 0.25 * model_.element_volume_m3()[e];
+        for (int q = 0; q < 4; ++q) {
+          Eigen::Matrix<double, 3, 2> pair;
+          pair.col(0) = quarter * (r * b.col(q));
+          pair.col(1) = quarter * (stretch * b.col(q));
+          gh.emplace_back(nodes[uz(q)], pair);
+        }
+      }
+      const double weight = model_.node_bulk_modulus_pa()[a] / model_.node_volume_m3()[a];
+      for (const auto& [i, gi] : gh) {
+        for (const auto& [j, hj] : gh) {
+          const Eigen::Matrix3d block = weight * gi.col(0) * hj.col(1).transpose();
+          for (int r = 0; r < 3; ++r) {
+            const int row = dof_[uz(3 * i + r)];
+            if (row < 0) continue;
+            for (int c = 0; c < 3; ++c) {
+              const int col = dof_[uz(3 * j + c)];
+              if (col >= 0) triplets.emplace_back(row, col, block(r, c));
+            }
+          }
+        }
+      }
+    }
+  }
+
   // Newton direction -J^-1 r with J = dr/dX over the free DOFs, assembled from central
   // differences of the element loads in each element's own frame (coordinates relative to
   // corner 0, so the step is not lost against large absolute coordinates).
@@ -371,11 +415,16 @@ class RestShapeSolver {
     std::vector<Eigen::Triplet<double>> triplets;
     triplets.reserve(uz(144 * model_.element_count()));
     const double density = model_.material().density_kg_m3;
+    // Under the nodal formulation the element blocks carry the deviatoric stress and the
+    // element's pressure held fixed (its change with the element's own rest geometry);
+    // add_volumetric_tangent adds the change of the pressures.
+    model_.set_rest_position(rest);
+    const Eigen::VectorXd pressure = element_pressure_pa(model_, observed_);
     for (int e = 0; e < model_.element_count(); ++e) {
       const auto& nodes = model_.elements()[uz(e)];
       const double youngs = model_.youngs_modulus_pa()[e];
       const double mu = youngs * model_.unit_mu();
-      const double lambda = youngs * model_.unit_lambda();
+      const double lambda = youngs * model_.unit_element_lambda();
       Mat34 x = gather(observed_, nodes);
       x = x.colwise() - x.col(0).eval();
       Mat34 x_rest = gather(rest, nodes);
@@ -391,8 +440,8 @@ class RestShapeSolver {
         Mat34 minus = x_rest;
         plus(j % 3, j / 3) += h;
         minus(j % 3, j / 3) -= h;
-        const Mat34 diff =
-            element_load(plus, x, mu, lambda, density, gravity) - element_load(minus, x, mu, lambda, density, gravity);
+        const Mat34 diff = element_load(plus, x, mu, lambda, pressure[e], density, gravity) -
+                           element_load(minus, x, mu, lambda, pressure[e], density, gravity);
         jac.col(j) = Eigen::Map<const Vec12>(diff.data()) / (2.0 * h);
       }
       for (int a = 0; a < 4; ++a) {
@@ -408,6 +457,7 @@ class RestShapeSolver {
         }
       }
     }
+    if (model_.nodal_volumetric()) add_volumetric_tangent(triplets);
     Eigen::SparseMatrix<double> jacobian(free_dofs_, free_dofs_);
     jacobian.setFromTriplets(triplets.begin(), triplets.end());
     if (!lu_analyzed_) {  // the pattern never changes: order it once

@@ -18,6 +18,12 @@
 // where they are observed: X_i = x_s_i. This is the only choice consistent with the forward
 // model, which keeps fixed nodes at their rest positions.
 //
+// Averaged nodal pressure (FemVolumetric::nodal_average). The residual is the model's own. The
+// Jacobian's element blocks then carry the deviatoric stress and each element's pressure held
+// fixed, and the change of the nodal pressures with X is added node by node (it couples nodes
+// two element rings apart, which element blocks cannot). The change of the pressure's lever
+// arms between elements is left out, so Newton converges a little slower, to the same answer.
+//
 // Method (RestShapeMethod::newton, the default). Newton's method on r(X) = 0 over the free DOFs,
 // starting from X = x_s. The Jacobian dr/dX is assembled from 12x12 element blocks, each the
 // central-difference derivative of the element's corner forces AND its share of the gravity load
