@@ -137,6 +137,12 @@ RefineCommand::RefineCommand(CLI::App& parent) {
                    "or in the current directory without --json OUT)")
       ->type_name("FILE");
   app_->add_option("--until", until_s_, "Use only frames with t <= S seconds")->type_name("S");
+  app_->add_option("--volumetric", volumetric_,
+                   "How the FEM integrates the volume change: auto (nodal_average from poisson_ratio 0.45 up), "
+                   "element (plain linear tetrahedra; they lock as poisson_ratio nears 0.5) or nodal_average "
+                   "(averaged nodal pressure, docs/fem.md)")
+      ->type_name("auto|element|nodal_average")
+      ->capture_default_str();
   app_->add_option("--substeps", substeps_, "trajectory: Newmark substeps per frame interval (1-64)")
       ->type_name("N")
       ->capture_default_str();
@@ -153,6 +159,9 @@ int RefineCommand::run() const {
   if (app_->count("--estimate") > 0) request = parse_estimate_list(estimate_);
   if (estimator_ != "auto" && estimator_ != "force" && estimator_ != "reaction" && estimator_ != "trajectory") {
     throw UsageError("--estimator must be auto, force, reaction or trajectory");
+  }
+  if (volumetric_ != "auto" && volumetric_ != "element" && volumetric_ != "nodal_average") {
+    throw UsageError("--volumetric must be auto, element or nodal_average");
   }
   if (!(max_strain_ > 0.0 && max_strain_ <= 1.0)) throw UsageError("--max-strain must be in (0, 1]");
   if (app_->count("--initial-modulus") > 0 && !(std::isfinite(initial_modulus_pa_) && initial_modulus_pa_ > 0.0)) {
@@ -186,6 +195,8 @@ int RefineCommand::run() const {
     throw UsageError(e.what());
   }
   if (app_->count("--until") > 0) host::fem::keep_frames_until(problem, until_s_);
+  if (volumetric_ == "element") problem.material.volumetric = host::fem::FemVolumetric::element;
+  if (volumetric_ == "nodal_average") problem.material.volumetric = host::fem::FemVolumetric::nodal_average;
 
   const RefinePlan plan = plan_refine(problem, request, estimator_);
   check_rest_shape(problem, plan, rest_frame_);

@@ -24,6 +24,7 @@ class RefineCommand {
   std::string mesh_path_;
   std::string estimate_;
   std::string estimator_ = "auto";
+  std::string volumetric_ = "auto";
   std::string json_path_;
   std::string vtk_dir_;
   double max_strain_ = 0.10;

@@ -40,6 +40,9 @@ std::string row(const std::string& key, const std::string& value) {
 
 // How the model integrates the volume, and why (fem_model.hpp).
 std::string volumetric_words(const host::fem::FemMaterial& material) {
+  if (material.volumetric != host::fem::FemVolumetric::automatic) {
+    return std::string(host::fem::to_string(material.volumetric)) + " (--volumetric)";
+  }
   if (host::fem::resolved_volumetric(material) == host::fem::FemVolumetric::nodal_average) {
     return "nodal_average (averaged nodal pressure: poisson_ratio " + num(material.poisson_ratio) +
            " >= " + num(host::fem::kNodalAverageFromPoisson) + ", where the plain linear tetrahedron locks)";

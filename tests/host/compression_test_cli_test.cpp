@@ -161,19 +161,23 @@ double calculix_bonded_factor(double nu) {
   return std::nan("");
 }
 
-double refined_modulus_pa(const TempDir& dir, const std::string& contact) {
+// Imports EF30 with `contact` at nu 0.48 (once per directory and contact) and refines it with
+// `volumetric` ("auto" for the default); the card must name the formulation that ran.
+double refined_modulus_pa(const TempDir& dir, const std::string& contact, const std::string& volumetric = "auto") {
   const std::string out = dir / contact;
-  const CommandResult imported =
-      run_pliant("import compression " + quoted(kEf30) + " -o " + quoted(out) + " --contact " + contact +
-                 " --poisson-ratio 0.48 --density 1040 --mesh-divisions 2,24,5 --frame-interval 10");
-  EXPECT_EQ(imported.status, 0) << imported.err;
-  const std::string card = dir / (contact + ".json");
-  const CommandResult refined =
-      run_pliant("refine " + quoted(out) + " --estimate youngs_modulus -q --json " + quoted(card));
+  if (!std::ifstream(out + "/recording.json")) {
+    const CommandResult imported =
+        run_pliant("import compression " + quoted(kEf30) + " -o " + quoted(out) + " --contact " + contact +
+                   " --poisson-ratio 0.48 --density 1040 --mesh-divisions 2,24,5 --frame-interval 10");
+    EXPECT_EQ(imported.status, 0) << imported.err;
+  }
+  const std::string card = dir / (contact + "_" + volumetric + ".json");
+  const CommandResult refined = run_pliant("refine " + quoted(out) + " --estimate youngs_modulus -q --volumetric " +
+                                           volumetric + " --json " + quoted(card));
   EXPECT_EQ(refined.status, 0) << refined.err;
   std::ifstream file(card);
   const nlohmann::json json = nlohmann::json::parse(file);
-  EXPECT_EQ(json.at("volumetric"), "nodal_average");
+  EXPECT_EQ(json.at("volumetric"), volumetric == "element" ? "element" : "nodal_average");
   return json.at("parameters").at("youngs_modulus").get<double>();
 }
 
@@ -187,6 +191,14 @@ TEST(cli_import, BondedPlatensReadTheModulusAConvergedFemImplies) {
   std::printf("EF30 nu 0.48: frictionless %.1f kPa, bonded %.1f kPa, expected %.1f kPa (%+.1f %%)\n",
               frictionless / 1e3, bonded / 1e3, expected / 1e3, 100 * (bonded / expected - 1));
   EXPECT_NEAR(bonded / expected, 1.0, 0.08);
+  // Forced back to the plain element, the same fit locks and reads far too low.
+  const double locked = refined_modulus_pa(dir, "bonded", "element");
+  std::printf("EF30 nu 0.48, --volumetric element: bonded %.1f kPa (%+.1f %%)\n", locked / 1e3,
+              100 * (locked / expected - 1));
+  EXPECT_LT(locked / expected, 0.85);
+  const CommandResult bad = run_pliant("refine " + quoted(dir / "bonded") + " --volumetric quadratic");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_TRUE(contains(bad.err, "--volumetric must be auto, element or nodal_average")) << bad.err;
 }
 
 }  // namespace
