@@ -317,44 +317,27 @@ ElementRotations element_rotations(const FemModel& model, const Eigen::Ref<const
   return out;
 }
 
-// Sums the entries of a (node, vector) list that share a node; the list comes out sorted.
-void merge_by_node(std::vector<std::pair<int, Eigen::Vector3d>>& list) {
-  std::sort(list.begin(), list.end(), [](const auto& l, const auto& r) { return l.first < r.first; });
-  std::size_t out = 0;
-  for (std::size_t k = 0; k < list.size(); ++k) {
-    if (out > 0 && list[out - 1].first == list[k].first) {
-      list[out - 1].second += list[k].second;
-    } else {
-      list[out++] = list[k];
-    }
-  }
-  list.resize(out);
-}
-
-// (kappa_a / V_a) g_a g_a^T per node, g_a = sum_{e at a} (V_e / 4) R_e b_e (3n, sparse).
-void add_volumetric_triplets(const FemModel& model, const ElementRotations& state,
-                             std::vector<Eigen::Triplet<double>>& triplets) {
-  std::vector<std::pair<int, Eigen::Vector3d>> g;
+// sum_a (kappa_a / V_a) g_a g_a^T, g_a = sum_{e at a} (V_e / 4) R_e b_e, as the product
+// G^T W G of the n x 3n matrix G whose row a is g_a^T (about 3 x patch entries per row) and
+// W = diag(kappa_a / V_a): memory stays that of the result, not of its repeated outer products.
+Eigen::SparseMatrix<double> volumetric_tangent(const FemModel& model, const ElementRotations& state) {
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(uz(model.node_element_offsets().back()) * 12);
   for (int a = 0; a < model.node_count(); ++a) {
-    g.clear();
     for (int k = model.node_element_offsets()[uz(a)]; k < model.node_element_offsets()[uz(a) + 1]; ++k) {
       const int e = model.node_elements()[uz(k)];
-      const detail::Mat34 c = state.rotation[uz(e)] * model.shape_gradients(e);
+      const detail::Mat34 c =
+          (0.25 * model.element_volume_m3()[e]) * (state.rotation[uz(e)] * model.shape_gradients(e));
       for (int q = 0; q < 4; ++q) {
-        g.emplace_back(model.elements()[uz(e)][uz(q)], 0.25 * model.element_volume_m3()[e] * c.col(q));
-      }
-    }
-    merge_by_node(g);
-    const double weight = model.node_bulk_modulus_pa()[a] / model.node_volume_m3()[a];
-    for (const auto& [i, gi] : g) {
-      for (const auto& [j, gj] : g) {
-        const Eigen::Matrix3d block = weight * gi * gj.transpose();
-        for (int r = 0; r < 3; ++r) {
-          for (int col = 0; col < 3; ++col) triplets.emplace_back(3 * i + r, 3 * j + col, block(r, col));
-        }
+        for (int d = 0; d < 3; ++d) entries.emplace_back(a, 3 * model.elements()[uz(e)][uz(q)] + d, c(d, q));
       }
     }
   }
+  Eigen::SparseMatrix<double> g(model.node_count(), model.dof_count());
+  g.setFromTriplets(entries.begin(), entries.end());  // sums an element's repeated corners
+  const Eigen::VectorXd weight = model.node_bulk_modulus_pa().cwiseQuotient(model.node_volume_m3());
+  const Eigen::SparseMatrix<double> weighted = weight.asDiagonal() * g;
+  return Eigen::SparseMatrix<double>(g.transpose() * weighted);
 }
 
 }  // namespace
@@ -435,20 +418,17 @@ Eigen::SparseMatrix<double> stiffness_matrix(const FemModel& model,
       }
     }
   }
-  if (model.nodal_volumetric()) add_volumetric_triplets(model, state, triplets);
   Eigen::SparseMatrix<double> k(model.dof_count(), model.dof_count());
   k.setFromTriplets(triplets.begin(), triplets.end());
+  if (model.nodal_volumetric()) k += volumetric_tangent(model, state);
   return k;
 }
 
 Eigen::SparseMatrix<double> volumetric_stiffness_matrix(const FemModel& model,
                                                         const Eigen::Ref<const Eigen::VectorXd>& position_m) {
   const ElementRotations state = element_rotations(model, position_m);
-  std::vector<Eigen::Triplet<double>> triplets;
-  if (model.nodal_volumetric()) add_volumetric_triplets(model, state, triplets);
-  Eigen::SparseMatrix<double> k(model.dof_count(), model.dof_count());
-  k.setFromTriplets(triplets.begin(), triplets.end());
-  return k;
+  if (model.nodal_volumetric()) return volumetric_tangent(model, state);
+  return Eigen::SparseMatrix<double>(model.dof_count(), model.dof_count());
 }
 
 Eigen::VectorXd element_pressure_pa(const FemModel& model, const Eigen::Ref<const Eigen::VectorXd>& position_m) {
