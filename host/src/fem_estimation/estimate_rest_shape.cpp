@@ -369,40 +369,42 @@ class RestShapeSolver {
   // pressures gives sum_a (kappa_a / V_a) g_a h_a^T with g_a = sum_{e at a} (V_e / 4) R_e b_e and
   // h_a = sum_{e at a} (V_e / 4) S_e b_e (not symmetric). The change of g_a itself with X is left
   // to the element blocks' held pressure.
+  // Assembled as the product G^T W H of the n x 3n matrices whose rows are g_a and h_a, with
+  // W = diag(kappa_a / V_a), then restricted to the free DOFs.
   void add_volumetric_tangent(std::vector<Eigen::Triplet<double>>& triplets) const {
-    const auto& offsets = model_.node_element_offsets();
-    const auto& stars = model_.node_elements();
-    std::vector<std::pair<int, Eigen::Matrix<double, 3, 2>>> gh;
-    for (int a = 0; a < model_.node_count(); ++a) {
-      gh.clear();
-      for (int k = offsets[uz(a)]; k < offsets[uz(a) + 1]; ++k) {
-        const int e = stars[uz(k)];
-        const auto& nodes = model_.elements()[uz(e)];
-        const Mat34& b = model_.shape_gradients(e);
+    const int n = model_.node_count();
+    std::vector<Eigen::Triplet<double>> g_entries;
+    std::vector<Eigen::Triplet<double>> h_entries;
+    for (int a = 0; a < n; ++a) {
+      for (int k = model_.node_element_offsets()[uz(a)]; k < model_.node_element_offsets()[uz(a) + 1]; ++k) {
+        const int e = model_.node_elements()[uz(k)];
         const Eigen::Matrix3d f = deformation_gradient(model_, e, observed_);
         const Eigen::Matrix3d r = polar_rotation(f);
-        const Eigen::Matrix3d stretch = r.transpose() * f;
         const double quarter = 0.25 * model_.element_volume_m3()[e];
+        const Mat34 g = quarter * (r * model_.shape_gradients(e));
+        const Mat34 h = quarter * ((r.transpose() * f) * model_.shape_gradients(e));
         for (int q = 0; q < 4; ++q) {
-          Eigen::Matrix<double, 3, 2> pair;
-          pair.col(0) = quarter * (r * b.col(q));
-          pair.col(1) = quarter * (stretch * b.col(q));
-          gh.emplace_back(nodes[uz(q)], pair);
-        }
-      }
-      const double weight = model_.node_bulk_modulus_pa()[a] / model_.node_volume_m3()[a];
-      for (const auto& [i, gi] : gh) {
-        for (const auto& [j, hj] : gh) {
-          const Eigen::Matrix3d block = weight * gi.col(0) * hj.col(1).transpose();
-          for (int r = 0; r < 3; ++r) {
-            const int row = dof_[uz(3 * i + r)];
-            if (row < 0) continue;
-            for (int c = 0; c < 3; ++c) {
-              const int col = dof_[uz(3 * j + c)];
-              if (col >= 0) triplets.emplace_back(row, col, block(r, c));
-            }
+          for (int d = 0; d < 3; ++d) {
+            const int dof = 3 * model_.elements()[uz(e)][uz(q)] + d;
+            g_entries.emplace_back(a, dof, g(d, q));
+            h_entries.emplace_back(a, dof, h(d, q));
           }
         }
+      }
+    }
+    Eigen::SparseMatrix<double> g(n, 3 * n);
+    Eigen::SparseMatrix<double> h(n, 3 * n);
+    g.setFromTriplets(g_entries.begin(), g_entries.end());
+    h.setFromTriplets(h_entries.begin(), h_entries.end());
+    const Eigen::VectorXd weight = model_.node_bulk_modulus_pa().cwiseQuotient(model_.node_volume_m3());
+    const Eigen::SparseMatrix<double> weighted = weight.asDiagonal() * h;
+    const Eigen::SparseMatrix<double> tangent = g.transpose() * weighted;
+    for (int col = 0; col < tangent.outerSize(); ++col) {
+      const int c = dof_[uz(col)];
+      if (c < 0) continue;
+      for (Eigen::SparseMatrix<double>::InnerIterator it(tangent, col); it; ++it) {
+        const int row = dof_[uz(static_cast<int>(it.row()))];
+        if (row >= 0) triplets.emplace_back(row, c, it.value());
       }
     }
   }

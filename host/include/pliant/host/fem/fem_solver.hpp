@@ -23,7 +23,10 @@
 //
 // Linear solver: a supernodal sparse Cholesky on 3x3 node blocks, private to the library. The
 // symbolic analysis (AMD ordering on the node graph, elimination tree, supernodes) is done once
-// in the constructor; each iteration only assembles into the factor and refactorizes.
+// in the constructor; each iteration only assembles into the factor and refactorizes. Under the
+// model's averaged nodal pressure (FemModel::nodal_volumetric()) the node graph joins nodes two
+// element rings apart: the factor holds about 2.3-2.4 times the entries and a step costs about
+// 3.5-5 times as much (bench/fem_locking_bench).
 //
 // Reactions: after a step, r = M a+ + D(x+) v+ - f_int(x+) - f_ext - M g evaluated at the
 // constrained nodes (zero elsewhere): the force the supports and the driving tool apply to the
@@ -126,7 +129,8 @@ class FemSolver {
   /// fixed_nodes and driven_nodes: node indices, each in range, no repeats, disjoint (either may
   /// be empty). driven positions passed to step()/solve_static() follow the order of
   /// driven_nodes. Throws std::invalid_argument. Performs the symbolic analysis: O(nnz(L)) memory
-  /// for the factor, roughly a few tens of kB per 100 free nodes on bar-like meshes.
+  /// for the factor, roughly a few tens of kB per 100 free nodes on bar-like meshes (more than
+  /// twice that under the averaged nodal pressure).
   FemSolver(const FemModel& model, std::vector<int> fixed_nodes, std::vector<int> driven_nodes);
   ~FemSolver();
   FemSolver(FemSolver&&) noexcept;
