@@ -230,18 +230,6 @@ void FemModel::set_rest_position(const Eigen::Ref<const Eigen::VectorXd>& rest_m
   update_node_bulk();
 }
 
-FemModel with_volumetric(const FemModel& model, FemVolumetric volumetric) {
-  TetMesh mesh;
-  mesh.points.assign(model.rest_position_m().data(), model.rest_position_m().data() + model.dof_count());
-  mesh.tetrahedra.reserve(4 * uz(model.element_count()));
-  for (const auto& nodes : model.elements()) mesh.tetrahedra.insert(mesh.tetrahedra.end(), nodes.begin(), nodes.end());
-  mesh.youngs_modulus.assign(model.youngs_modulus_pa().data(),
-                             model.youngs_modulus_pa().data() + model.element_count());
-  FemMaterial material = model.material();
-  material.volumetric = volumetric;
-  return FemModel(mesh, material);
-}
-
 Eigen::Matrix3d polar_rotation(const Eigen::Matrix3d& f) {
   if (!f.allFinite()) return Eigen::Matrix3d::Identity();
   const double norm2 = f.squaredNorm();

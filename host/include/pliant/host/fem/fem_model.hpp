@@ -182,11 +182,6 @@ class FemModel {
   std::vector<int> node_elements_;
 };
 
-/// A copy of `model` (its mesh, current rest shape, per-element moduli and material) with the
-/// volumetric part integrated as `volumetric` (automatic resolves from the current Poisson
-/// ratio). O(n + m).
-FemModel with_volumetric(const FemModel& model, FemVolumetric volumetric);
-
 /// The rotation of the polar decomposition F = R S (R proper, det R = +1). Robust for inverted
 /// (det F < 0) and degenerate (flat, collinear, collapsed) F: an SVD with the reflection moved to
 /// the smallest singular value, so S = R^T F stays symmetric and no NaN is produced for finite F.
