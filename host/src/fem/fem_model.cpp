@@ -420,9 +420,10 @@ Eigen::SparseMatrix<double> volumetric_stiffness_matrix(const FemModel& model,
 }
 
 Eigen::VectorXd element_pressure_pa(const FemModel& model, const Eigen::Ref<const Eigen::VectorXd>& position_m) {
-  const ElementRotations state = element_rotations(model, position_m);
+  if (position_m.size() != model.dof_count()) throw std::invalid_argument("FEM: positions must have 3n entries");
   Eigen::VectorXd pressure = Eigen::VectorXd::Zero(model.element_count());
   if (!model.nodal_volumetric()) return pressure;
+  const ElementRotations state = element_rotations(model, position_m);
   for (int e = 0; e < model.element_count(); ++e) {
     pressure[e] = detail::element_pressure(model.elements()[uz(e)], state.node_pressure.data());
   }

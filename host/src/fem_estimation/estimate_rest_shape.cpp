@@ -419,8 +419,8 @@ class RestShapeSolver {
     const double density = model_.material().density_kg_m3;
     // Under the nodal formulation the element blocks carry the deviatoric stress and the
     // element's pressure held fixed (its change with the element's own rest geometry);
-    // add_volumetric_tangent adds the change of the pressures.
-    model_.set_rest_position(rest);
+    // add_volumetric_tangent adds the change of the pressures. The model's rest shape is `rest`
+    // already: newton_stage evaluated it last.
     const Eigen::VectorXd pressure = element_pressure_pa(model_, observed_);
     for (int e = 0; e < model_.element_count(); ++e) {
       const auto& nodes = model_.elements()[uz(e)];
