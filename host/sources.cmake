@@ -35,6 +35,7 @@ set(PLIANT_FEM_SOURCES
   ${pliant_host_src}/fem/fem_cholesky.cpp
   ${pliant_host_src}/fem/fem_solver.cpp
   ${pliant_host_src}/fem/fem_modal.cpp
+  ${pliant_host_src}/fem/fem_condensation.cpp
   ${pliant_host_src}/fem/fem_recording.cpp
   ${pliant_host_src}/fem/material_map.cpp)
 # the one least-squares path, on Ceres (least_squares_fit.hpp)
@@ -68,6 +69,7 @@ set(PLIANT_DIAGNOSIS_SOURCES
   ${pliant_host_src}/diagnose/selection.cpp
   ${pliant_host_src}/diagnose/engine.cpp
   ${pliant_host_src}/diagnose/diagnose.cpp
+  ${pliant_host_src}/diagnose/support_friction.cpp
   ${pliant_host_src}/diagnose/fem_model_run.cpp
   ${pliant_host_src}/diagnose/fem_effects.cpp
   ${pliant_host_src}/diagnose/fem_diagnose.cpp

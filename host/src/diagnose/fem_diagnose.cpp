@@ -830,6 +830,14 @@ std::string effect_detail(const FemEffect& effect, const FemFit& f, const FemEff
   } else if (effect.name == "gravity") {
     text << " A body acceleration of (" << number(f.values[0]) << ", " << number(f.values[1]) << ", "
          << number(f.values[2]) << ") m/s^2 acts that the recording does not declare.";
+  } else if (effect.name == "friction") {
+    const double slip = f.values[0];
+    text << " The supports slide on their plane";
+    if (slip >= 1.0) {
+      text << " without friction.";
+    } else {
+      text << " with a friction coefficient of " << number(1.0 / slip - 1.0) << ".";
+    }
   } else if (effect.name == "plasticity") {
     text << " Above an equivalent strain of " << number(f.values[0]) << " the rest shape creeps at "
          << number(f.values[1]) << " /s: a permanent set.";
@@ -958,6 +966,7 @@ class FemDiagnosis final : public DiagnosisModel {
     context_.has_wrench = !recording_.wrench.empty() && !recording_.wrench_applied_to.empty();
     context_.positions_compared = positions_;
     context_.unloads = unloads(recording_);
+    context_.support_plane = simulator_->has_support_plane();
     context_.duration_s = duration_;
     context_.frame_interval_s = duration_ / std::max(1, (frames - 1) / (context_.quasi_static ? stride_ : 1));
     context_.recording_interval_s = duration_ / std::max(1, frames - 1);

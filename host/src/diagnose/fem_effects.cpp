@@ -47,6 +47,12 @@ void apply_heterogeneity(const std::vector<double>& v, const FemEffectContext& c
     s.element_factor[e] = factor[static_cast<std::size_t>(c.element_patch[e])];
 }
 
+// Searched as slip = 1 / (1 + mu) in [0, 1]: 0 is the pin (the baseline), 1 frictionless.
+void apply_friction(const std::vector<double>& v, const FemEffectContext&, FemRunSettings& s) {
+  const double slip = std::clamp(v[0], 0.0, 1.0);
+  s.support_friction = slip <= 0.0 ? -1.0 : 1.0 / slip - 1.0;
+}
+
 void apply_plasticity(const std::vector<double>& v, const FemEffectContext&, FemRunSettings& s) {
   s.plastic_yield = v[0];
   s.plastic_creep = v[1];
@@ -134,6 +140,17 @@ std::vector<FemEffect> fem_effect_catalogue(const FemEffectContext& context) {
     effects.push_back({"heterogeneity", factors, apply_heterogeneity,
                        "regions of different stiffness (a modulus factor per patch of elements)",
                        "pressing at a second site: a stiffer or softer region moves with the material"});
+  }
+
+  if (context.support_plane) {
+    effects.push_back({"friction",
+                       {{"slip", 0.0, 1.0, 0.0, Scale::linear, true}},
+                       apply_friction,
+                       "supports that slide on their plane with Coulomb friction instead of being pinned",
+                       "marking the support contacts, or a lubricated or glued support: friction moves only them, "
+                       "and they stop at load reversals",
+                       false,
+                       true});
   }
 
   if (context.unloads) {

@@ -8,6 +8,8 @@
 #include <map>
 #include <stdexcept>
 
+#include "pliant/host/diagnose/support_friction.hpp"
+#include "pliant/host/fem/fem_condensation.hpp"
 #include "pliant/host/fem/fem_modal.hpp"
 #include "pliant/host/fem/fem_model.hpp"
 #include "pliant/host/fem/fem_recording.hpp"
@@ -18,6 +20,9 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kPi = 3.14159265358979323846;
+// Rounds of (solve the full model, find the slips on the condensed one) per frame with sliding
+// supports; the slips usually settle in 2-4.
+constexpr int kMaxSlipRounds = 25;
 // Cap of k eps^2 in exp(k eps^2): moduli stay within 1.6e5 times E, so the stiffness matrix stays
 // well conditioned in badly distorted elements.
 constexpr double kMaxStiffeningExponent = 12.0;
@@ -75,6 +80,14 @@ struct FemRecordingSimulator::Impl {
   double declared_beta = 0;
   Eigen::Vector3d declared_gravity = Eigen::Vector3d::Zero();
   std::map<std::vector<int>, std::unique_ptr<fem::FemSolver>> solvers;
+  // Sliding supports (support_friction >= 0): the fixed nodes held as driven nodes at trial
+  // positions, one solver per set of other driven nodes; their stiffness condensed onto them,
+  // per driven set and step (static at E = 1 Pa, scaled; dynamic at the run's E).
+  SupportPlane support_plane;
+  std::map<std::vector<int>, std::unique_ptr<fem::FemSolver>> sliding_solvers;
+  std::map<std::vector<int>, Eigen::MatrixXd> unit_support_stiffness;
+  std::map<std::pair<std::vector<int>, double>, Eigen::MatrixXd> step_support_stiffness;
+  double step_stiffness_modulus = 0;  // E of step_support_stiffness
   // The last elastic run, reused when only the force post-processing changes (a run of all
   // solved frames also serves a fitting-only request).
   bool cache_valid = false;
@@ -164,8 +177,12 @@ struct FemRecordingSimulator::Impl {
   void solve_static_frame(int f, const FemRunSettings& settings, const Eigen::VectorXd& base, Eigen::VectorXd& x,
                           Eigen::VectorXd& reaction) {
     const std::vector<int> driven = driven_of(f);
-    fem::FemSolver& solver = solver_for(driven);
-    const Eigen::VectorXd target = driven_positions(f, driven);
+    equilibrium(f, solver_for(driven), driven_positions(f, driven), settings, base, x, reaction);
+  }
+
+  // The static equilibrium of frame f with `solver`'s driven nodes at `target`.
+  void equilibrium(int f, fem::FemSolver& solver, const Eigen::VectorXd& target, const FemRunSettings& settings,
+                   const Eigen::VectorXd& base, Eigen::VectorXd& x, Eigen::VectorXd& reaction) {
     const Eigen::VectorXd load = load_of(f, settings.wrench_latency_s, x);
     const double k = settings.stiffening;
     if (k == 0.0) model->set_youngs_modulus(base);
@@ -219,6 +236,114 @@ struct FemRecordingSimulator::Impl {
       x = mixed.allFinite() ? mixed : images.back();
     }
     throw std::runtime_error("static solve did not converge in frame " + std::to_string(f));
+  }
+
+  // --- sliding supports ---------------------------------------------------------------------
+
+  bool sliding(const FemRunSettings& settings) const { return settings.support_friction >= 0 && support_plane.valid; }
+
+  fem::FemSolver& sliding_solver_for(const std::vector<int>& driven) {
+    auto found = sliding_solvers.find(driven);
+    if (found != sliding_solvers.end()) return *found->second;
+    std::vector<int> held = problem.fixed_nodes;
+    held.insert(held.end(), driven.begin(), driven.end());
+    auto solver = std::make_unique<fem::FemSolver>(*model, std::vector<int>{}, held);
+    fem::FemSolver& ref = *solver;
+    sliding_solvers.emplace(driven, std::move(solver));
+    return ref;
+  }
+
+  // The supports' stiffness with the driven nodes held: static (dt 0) at `modulus`, or that of
+  // one Newmark step of length dt (mass and Rayleigh terms included).
+  Eigen::MatrixXd support_stiffness(const std::vector<int>& driven, double dt, double modulus) {
+    if (dt <= 0) {
+      auto found = unit_support_stiffness.find(driven);
+      if (found == unit_support_stiffness.end()) {
+        fem::FemModel unit = *model;
+        unit.set_rest_position(rest0);
+        unit.set_youngs_modulus(1.0);
+        found =
+            unit_support_stiffness.emplace(driven, fem::condensed_stiffness(unit, rest0, problem.fixed_nodes, driven))
+                .first;
+      }
+      return modulus * found->second;
+    }
+    if (modulus != step_stiffness_modulus) {
+      step_support_stiffness.clear();
+      step_stiffness_modulus = modulus;
+    }
+    const auto key = std::make_pair(driven, dt);
+    auto found = step_support_stiffness.find(key);
+    if (found == step_support_stiffness.end()) {
+      fem::FemModel scaled = *model;
+      scaled.set_rest_position(rest0);
+      scaled.set_youngs_modulus(modulus);
+      const double alpha = model->rayleigh_alpha();
+      const double beta = model->rayleigh_beta();
+      found = step_support_stiffness
+                  .emplace(key, fem::condensed_stiffness(scaled, rest0, problem.fixed_nodes, driven,
+                                                         1.0 + 2.0 * beta / dt, 4.0 / (dt * dt) + 2.0 * alpha / dt))
+                  .first;
+    }
+    return found->second;
+  }
+
+  // The entries of a 3n per-node vector at the supports (3 per fixed node, in their order).
+  Eigen::VectorXd at_supports(const Eigen::VectorXd& per_node) const {
+    Eigen::VectorXd out(3 * static_cast<Eigen::Index>(problem.fixed_nodes.size()));
+    for (std::size_t i = 0; i < problem.fixed_nodes.size(); ++i) {
+      out.segment<3>(3 * static_cast<Eigen::Index>(i)) = per_node.segment<3>(3 * problem.fixed_nodes[i]);
+    }
+    return out;
+  }
+
+  // Rounds of: hold the supports at anchors + slip and solve (`solve_held`, which returns the
+  // reactions), then find the slips that satisfy Coulomb's law on the condensed stiffness. The
+  // anchors advance by the frame's slip.
+  template <typename SolveHeld>
+  void slide(double mu, const Eigen::MatrixXd& stiffness, Eigen::VectorXd& anchors, SolveHeld&& solve_held) {
+    const double slip_tolerance = 100.0 * tolerance;  // 1e-6 of the object's size
+    Eigen::VectorXd slip = Eigen::VectorXd::Zero(anchors.size());
+    for (int round = 0; round < kMaxSlipRounds; ++round) {
+      const Eigen::VectorXd held = at_supports(solve_held(Eigen::VectorXd(anchors + slip)));
+      const Eigen::VectorXd next = coulomb_slip(support_plane, mu, held, stiffness, slip, 1e-2 * slip_tolerance);
+      const double change = (next - slip).cwiseAbs().maxCoeff();
+      slip = next;
+      if (change <= slip_tolerance) break;
+    }
+    anchors += slip;
+  }
+
+  void solve_static_frame_sliding(int f, const FemRunSettings& settings, const Eigen::VectorXd& base,
+                                  Eigen::VectorXd& x, Eigen::VectorXd& reaction, Eigen::VectorXd& anchors) {
+    const std::vector<int> driven = driven_of(f);
+    fem::FemSolver& solver = sliding_solver_for(driven);
+    const Eigen::Index supports = anchors.size();
+    Eigen::VectorXd target(supports + 3 * static_cast<Eigen::Index>(driven.size()));
+    target.tail(target.size() - supports) = driven_positions(f, driven);
+    slide(settings.support_friction, support_stiffness(driven, 0.0, settings.youngs_modulus_pa), anchors,
+          [&](const Eigen::VectorXd& at_supports) {
+            target.head(supports) = at_supports;
+            equilibrium(f, solver, target, settings, base, x, reaction);
+            return reaction;
+          });
+  }
+
+  void step_sliding(int f, double dt, const FemRunSettings& settings, const Eigen::VectorXd& load,
+                    const fem::FemStepOptions& options, fem::FemState& state, Eigen::VectorXd& anchors) {
+    const std::vector<int> driven = driven_of(f);
+    fem::FemSolver& solver = sliding_solver_for(driven);
+    const Eigen::Index supports = anchors.size();
+    Eigen::VectorXd target(supports + 3 * static_cast<Eigen::Index>(driven.size()));
+    target.tail(target.size() - supports) = driven_positions(f, driven);
+    const fem::FemState start = state;
+    slide(settings.support_friction, support_stiffness(driven, dt, settings.youngs_modulus_pa), anchors,
+          [&](const Eigen::VectorXd& at_supports) {
+            target.head(supports) = at_supports;
+            state = start;
+            solver.step(state, dt, target, load, options);
+            return solver.reaction_n();
+          });
   }
 
   // Plastic creep of the rest shape toward the current shape after a solved frame.
@@ -288,6 +413,11 @@ FemRecordingSimulator::FemRecordingSimulator(const Recording& recording, FemTime
 
   im.is_fixed.assign(at(im.n), 0);
   for (int id : im.problem.fixed_nodes) im.is_fixed[at(id)] = 1;
+  {
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (int i = 0; i < im.n; ++i) centre += im.rest0.segment<3>(3 * i);
+    im.support_plane = find_support_plane(im.rest0, im.problem.fixed_nodes, centre / std::max(1, im.n));
+  }
   im.node_elements.assign(at(im.n), {});
   for (int e = 0; e < im.model->element_count(); ++e) {
     for (int node : im.model->elements()[at(e)]) im.node_elements[at(node)].push_back(e);
@@ -356,6 +486,8 @@ bool FemRecordingSimulator::scale_invariant_at_fixed_gravity_ratio() const {
 }
 
 Eigen::Vector3d FemRecordingSimulator::declared_gravity_m_s2() const { return impl_->declared_gravity; }
+bool FemRecordingSimulator::has_support_plane() const { return impl_->support_plane.valid; }
+Eigen::Vector3d FemRecordingSimulator::support_normal() const { return impl_->support_plane.normal; }
 
 std::vector<double> FemRecordingSimulator::element_centroids() const {
   const fem::FemModel& model = *impl_->model;
@@ -438,7 +570,8 @@ bool same_physics(const FemRunSettings& a, const FemRunSettings& b, bool latency
   return a.youngs_modulus_pa == b.youngs_modulus_pa && a.extra_gravity_m_s2 == b.extra_gravity_m_s2 &&
          a.stiffening == b.stiffening && a.extra_rayleigh_beta == b.extra_rayleigh_beta &&
          a.plastic_yield == b.plastic_yield && a.plastic_creep == b.plastic_creep &&
-         (!latency_matters || a.wrench_latency_s == b.wrench_latency_s) && a.element_factor == b.element_factor;
+         (!latency_matters || a.wrench_latency_s == b.wrench_latency_s) && a.element_factor == b.element_factor &&
+         a.support_friction == b.support_friction;
 }
 
 }  // namespace
@@ -505,6 +638,9 @@ FemRecordingSimulator::ElasticRun FemRecordingSimulator::Impl::elastic_run(const
     Eigen::VectorXd strain;
     Eigen::VectorXd x = im.rest0;
     Eigen::VectorXd reaction;
+    const bool sliding = im.sliding(settings);
+    Eigen::VectorXd anchors;  // where the sliding supports stick (3 per fixed node)
+    if (sliding) anchors = im.at_supports(im.rest0);
     auto record = [&](int f, const Eigen::VectorXd& position, const Eigen::VectorXd& constraint_force) {
       std::copy(position.data(), position.data() + 3 * im.n,
                 run.positions.begin() + static_cast<long>(at(f) * at(im.n) * 3));
@@ -529,7 +665,11 @@ FemRecordingSimulator::ElasticRun FemRecordingSimulator::Impl::elastic_run(const
           const double ratio = std::min(2.0, (t - last_time) / (last_time - before_last_time));
           x = last + ratio * (last - before_last);
         }
-        im.solve_static_frame(f, settings, base, x, reaction);
+        if (sliding) {
+          im.solve_static_frame_sliding(f, settings, base, x, reaction, anchors);
+        } else {
+          im.solve_static_frame(f, settings, base, x, reaction);
+        }
         record(f, x, reaction);
         im.creep(settings, x, t - previous_time);
         previous_time = t;
@@ -539,7 +679,11 @@ FemRecordingSimulator::ElasticRun FemRecordingSimulator::Impl::elastic_run(const
         last_time = t;
       }
     } else {
-      im.solve_static_frame(0, settings, base, x, reaction);
+      if (sliding) {
+        im.solve_static_frame_sliding(0, settings, base, x, reaction, anchors);
+      } else {
+        im.solve_static_frame(0, settings, base, x, reaction);
+      }
       record(0, x, reaction);
       fem::FemState state;
       state.position_m = x;
@@ -558,12 +702,18 @@ FemRecordingSimulator::ElasticRun FemRecordingSimulator::Impl::elastic_run(const
           im.model->set_youngs_modulus(base);
         }
         const std::vector<int> driven = im.driven_of(f);
-        fem::FemSolver& solver = im.solver_for(driven);
         const Eigen::VectorXd load = im.load_of(f, settings.wrench_latency_s, state.position_m);
         if (driven != im.driven_of(f - 1)) state.acceleration_valid = false;
-        solver.step(state, dt, im.driven_positions(f, driven), load, options);
+        if (sliding) {
+          im.step_sliding(f, dt, settings, load, options, state, anchors);
+          reaction = im.sliding_solver_for(driven).reaction_n();
+        } else {
+          fem::FemSolver& solver = im.solver_for(driven);
+          solver.step(state, dt, im.driven_positions(f, driven), load, options);
+          reaction = solver.reaction_n();
+        }
         if (!state.position_m.allFinite()) throw std::runtime_error("the dynamic run diverged");
-        record(f, state.position_m, solver.reaction_n());
+        record(f, state.position_m, reaction);
         im.creep(settings, state.position_m, dt);
       }
     }

@@ -12,6 +12,8 @@
 // - gravity: always (an undeclared body force: sag, or weight in the measured force);
 // - heterogeneity: only when free node positions are compared (one net force cannot tell
 //   where a region is) and there are at least two patches;
+// - friction: when the fixed nodes lie on one plane (FemRecordingSimulator::has_support_plane):
+//   the supports slide on it with Coulomb friction instead of being pinned;
 // - plasticity: only when the recording unloads (a permanent set shows after unloading; during
 //   monotonic loading it is indistinguishable from softening).
 // Host code: allocates.
@@ -31,6 +33,7 @@ struct FemEffectContext {
   bool has_wrench = false;
   bool positions_compared = false;  ///< some free node is observed
   bool unloads = false;             ///< the drive or load falls back after its peak
+  bool support_plane = false;       ///< the fixed nodes lie on one plane
   double frame_interval_s = 1;      ///< mean interval between solved frames
   double recording_interval_s = 1;  ///< mean interval between the recording's frames
   double duration_s = 1;

@@ -37,6 +37,16 @@
 //   t is the stream's value at t + tau (loads).
 // - extra_gravity: a body acceleration added to the declared gravity.
 // - element_factor: per-element modulus factors (heterogeneity).
+// - support_friction mu (friction): the fixed nodes, when they lie on one plane, are not pins but
+//   contacts on that plane. They keep their distance to it (bonded in the normal direction: no
+//   lift-off) and slide in it under Coulomb's law: a support node sticks while the tangential
+//   force holding it is at most mu times the normal force pressing it on the plane, and slips
+//   with exactly that force, against its motion, once it would exceed it (no normal force: it
+//   slides freely). Static frames and dynamic steps are solved with the supports held at
+//   trial positions; the slips are found on the stiffness condensed onto the supports
+//   (fem_condensation.hpp) by projected Gauss-Seidel, and the full model is solved again until
+//   the slips change by less than 1e-6 of the object's size (at most 25 rounds). A slip is
+//   permanent: the next frame starts from where the supports ended.
 //
 // Units SI (m, s, N, Pa). Host code: allocates; throws std::invalid_argument from the
 // constructor when the recording cannot be an FEM problem, never from simulate() (a failed
@@ -64,6 +74,7 @@ struct FemRunSettings {
   double plastic_creep = 0;            ///< 1/s; 0: no plasticity
   double wrench_latency_s = 0;         ///< s; positive: the wrench stream lags
   std::vector<double> element_factor;  ///< per element; empty: 1 everywhere
+  double support_friction = -1;        ///< Coulomb mu of the support plane; < 0: pinned supports
 };
 
 enum class FemTimeMode { quasi_static, dynamic };
@@ -113,6 +124,11 @@ class FemRecordingSimulator {
   /// wrench load): the run at (c E, c g) is the run at (E, g) with every force times c and the
   /// same positions, so E can be profiled in closed form at a fixed ratio g / E.
   bool scale_invariant_at_fixed_gravity_ratio() const;
+  /// True when the fixed nodes span one plane (at least three, not on a line, off the plane by
+  /// at most 1e-3 of their extent): the supports can then slide (FemRunSettings::support_friction).
+  bool has_support_plane() const;
+  /// Unit normal of the support plane, pointing from it into the body (zero without a plane).
+  Eigen::Vector3d support_normal() const;
   /// Declared body acceleration (m/s^2; zero when the recording declares none).
   Eigen::Vector3d declared_gravity_m_s2() const;
   /// Declared material (from recording.material, else the defaults of fem_recording.hpp).
