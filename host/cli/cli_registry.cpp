@@ -11,8 +11,8 @@ const CliRegistry& cli_registry() {
   return registry;
 }
 
-std::string missing_command_message(std::string_view name) {
-  for (const CommandPart& part : cli_registry().commands) {
+std::string missing_command_message(const CliRegistry& registry, std::string_view name) {
+  for (const CommandPart& part : registry.commands) {
     if (part.name == name) return "";
   }
   for (const OptionalCommandNeed& need : kOptionalCommands) {

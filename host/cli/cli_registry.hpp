@@ -77,9 +77,9 @@ struct CliRegistry {
 /// The registry of this build, filled by register_built_parts() on first use.
 const CliRegistry& cli_registry();
 
-/// When `name` is an optional command this build lacks: "this pliant was built without OpenCV:
-/// track is not available". Empty otherwise (a command of this build, or no command of ours).
-std::string missing_command_message(std::string_view name);
+/// When `name` is an optional command `registry` lacks: "this pliant was built without OpenCV:
+/// track is not available". Empty otherwise (a command it has, or no command of ours).
+std::string missing_command_message(const CliRegistry& registry, std::string_view name);
 
 /// Registers every part of this build (generated: see the top).
 void register_built_parts(CliRegistry& registry);

@@ -57,7 +57,7 @@ std::vector<AddedCommand> add_optional_commands(CLI::App& app) {
 int run(int argc, char** argv) {
   // A command this build was made without: say so rather than "unknown command".
   if (argc > 1) {
-    const std::string missing = missing_command_message(argv[1]);
+    const std::string missing = missing_command_message(cli_registry(), argv[1]);
     if (!missing.empty()) {
       report_error("pliant", missing);
       return exit_usage;
