@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 
@@ -146,6 +147,10 @@ int TrackCommand::run() const {
   } catch (const webcam::InputError& e) {
     throw UsageError(e.what());
   }
+}
+
+void register_track_command(CliRegistry& registry) {
+  registry.commands.push_back({"track", [](CLI::App& parent) { return std::make_unique<TrackCommand>(parent); }});
 }
 
 }  // namespace pliant::cli

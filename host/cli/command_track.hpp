@@ -8,16 +8,18 @@
 
 #include <CLI/CLI.hpp>
 
+#include "cli_registry.hpp"
+
 namespace pliant::cli {
 
-class TrackCommand {
+class TrackCommand final : public OptionalCommand {
  public:
   /// Registers `track` on `parent`.
   explicit TrackCommand(CLI::App& parent);
 
-  bool selected() const { return app_->parsed(); }
+  bool selected() const override { return app_->parsed(); }
   /// Runs after a successful parse; throws on failure (see exit_status.hpp for the mapping).
-  int run() const;
+  int run() const override;
 
  private:
   CLI::App* app_ = nullptr;
@@ -39,5 +41,9 @@ class TrackCommand {
   std::string output_;
   bool quiet_ = false;
 };
+
+/// Adds the command to the registry's optional commands (compiled only when the webcam front end is built; called
+/// by the generated registration of cli_registry.hpp).
+void register_track_command(CliRegistry& registry);
 
 }  // namespace pliant::cli

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 #include <limits>
 #include <stdexcept>
 #include <system_error>
@@ -252,6 +253,11 @@ int TrackDepthCommand::run() const {
   std::cout.flush();
   if (!std::cout) throw std::runtime_error("cannot write to standard output");
   return exit_ok;
+}
+
+void register_track_depth_command(CliRegistry& registry) {
+  registry.commands.push_back(
+      {"track-depth", [](CLI::App& parent) { return std::make_unique<TrackDepthCommand>(parent); }});
 }
 
 }  // namespace pliant::cli

@@ -8,16 +8,18 @@
 
 #include <CLI/CLI.hpp>
 
+#include "cli_registry.hpp"
+
 namespace pliant::cli {
 
-class TrackDepthCommand {
+class TrackDepthCommand final : public OptionalCommand {
  public:
   /// Registers the subcommand and its options on `parent`.
   explicit TrackDepthCommand(CLI::App& parent);
 
-  bool selected() const { return app_->parsed(); }
+  bool selected() const override { return app_->parsed(); }
   /// Runs after a successful parse; throws on failure (see exit_status.hpp for the mapping).
-  int run() const;
+  int run() const override;
 
  private:
   CLI::App* app_ = nullptr;
@@ -40,5 +42,9 @@ class TrackDepthCommand {
   bool all_tracked_ = false;
   bool force_ = false;
 };
+
+/// Adds the command to the registry's optional commands (compiled only when the depth front end is built; called
+/// by the generated registration of cli_registry.hpp).
+void register_track_depth_command(CliRegistry& registry);
 
 }  // namespace pliant::cli

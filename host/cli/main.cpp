@@ -1,9 +1,12 @@
 // pliant command line: parses the arguments and hands over to one command.
 #include <iostream>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
+#include "cli_registry.hpp"
 #include "command_devices.hpp"
 #include "command_diagnose.hpp"
 #include "command_estimate.hpp"
@@ -13,8 +16,6 @@
 #include "command_replay.hpp"
 #include "command_simulate.hpp"
 #include "command_telemetry.hpp"
-#include "command_track.hpp"
-#include "command_track_depth.hpp"
 #include "exit_status.hpp"
 
 namespace pliant::cli {
@@ -37,7 +38,31 @@ int report_parse_error(const CLI::App& app, const CLI::ParseError& error) {
   return exit_usage;
 }
 
+// The optional commands of this build (cli_registry.hpp), added to `app` in their usual place.
+struct AddedCommand {
+  std::string label;  // "pliant track"
+  std::unique_ptr<OptionalCommand> command;
+};
+
+std::vector<AddedCommand> add_optional_commands(CLI::App& app) {
+  std::vector<AddedCommand> added;
+  for (const OptionalCommandNeed& need : kOptionalCommands) {
+    for (const CommandPart& part : cli_registry().commands) {
+      if (part.name == need.name) added.push_back({"pliant " + part.name, part.add(app)});
+    }
+  }
+  return added;
+}
+
 int run(int argc, char** argv) {
+  // A command this build was made without: say so rather than "unknown command".
+  if (argc > 1) {
+    const std::string missing = missing_command_message(cli_registry(), argv[1]);
+    if (!missing.empty()) {
+      report_error("pliant", missing);
+      return exit_usage;
+    }
+  }
   CLI::App app{"pliant: deformability (msm_beta) of soft objects from recorded trajectories", "pliant"};
   app.set_version_flag("--version", std::string("pliant ") + PLIANT_VERSION);
   app.footer(
@@ -49,8 +74,7 @@ int run(int argc, char** argv) {
   ImportCommand importer(app);
   RefineCommand refine(app);
   TelemetryCommand telemetry(app);
-  TrackCommand track(app);
-  TrackDepthCommand track_depth(app);
+  const std::vector<AddedCommand> optional_commands = add_optional_commands(app);  // track, track-depth
   ReplayCommand replay(app);
   DevicesCommand devices(app);
   RecordCommand record(app);
@@ -67,8 +91,10 @@ int run(int argc, char** argv) {
   if (importer.selected()) return run_reporting_errors("pliant import compression", [&] { return importer.run(); });
   if (refine.selected()) return run_reporting_errors("pliant refine", [&] { return refine.run(); });
   if (telemetry.selected()) return run_reporting_errors("pliant telemetry", [&] { return telemetry.run(); });
-  if (track.selected()) return run_reporting_errors("pliant track", [&] { return track.run(); });
-  if (track_depth.selected()) return run_reporting_errors("pliant track-depth", [&] { return track_depth.run(); });
+  for (const AddedCommand& optional : optional_commands) {
+    if (optional.command->selected())
+      return run_reporting_errors(optional.label, [&] { return optional.command->run(); });
+  }
   if (replay.selected()) return run_reporting_errors("pliant replay", [&] { return replay.run(); });
   if (devices.selected()) return run_reporting_errors("pliant devices", [&] { return devices.run(); });
   if (record.selected()) return run_reporting_errors("pliant record", [&] { return record.run(); });

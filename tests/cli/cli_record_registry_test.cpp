@@ -1,8 +1,8 @@
 // `pliant record` and the device registry (host/cli/record_devices.hpp, cli_registry.hpp): every
 // kind of spec becomes a hal::DeviceSpec whose parameters its driver declared, the CLI's table of
 // drivers agrees with what the drivers registered, and a kind whose driver this build lacks is
-// refused with the package to install. Which drivers are built varies; the checks hold for any
-// mix.
+// refused with the package to install; the optional commands (track, track-depth) and the words
+// for one a build lacks. Which drivers are built varies; the checks hold for any mix.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -104,6 +104,22 @@ TEST(CliRecordRegistry, NumbersAndOptionsAsParameters) {
   s = to_hal_spec(parse_device_spec(DeviceRole::ft, "ati-can:can0@0x20"), DeviceOpenOptions());
   EXPECT_EQ(s.integer("base_id", 0, 0x7f), 0x20);
   EXPECT_FALSE(s.flag("tare", true));
+}
+
+TEST(CliRecordRegistry, OptionalCommandsAndTheWordsForOneLeftOut) {
+  const CliRegistry empty;
+  EXPECT_EQ(missing_command_message(empty, "track"), "this pliant was built without OpenCV: track is not available");
+  EXPECT_EQ(missing_command_message(empty, "track-depth"),
+            "this pliant was built without the depth front end (libpng, nanoflann): track-depth is not available");
+  EXPECT_EQ(missing_command_message(empty, "estimate"), "");  // always built: not ours to explain
+  EXPECT_EQ(missing_command_message(empty, "trac"), "");
+  // This build: every command it registered is available, and each is a known optional one.
+  for (const CommandPart& part : cli_registry().commands) {
+    EXPECT_EQ(missing_command_message(cli_registry(), part.name), "") << part.name;
+    EXPECT_TRUE(std::any_of(std::begin(kOptionalCommands), std::end(kOptionalCommands),
+                            [&](const OptionalCommandNeed& need) { return need.name == part.name; }))
+        << part.name;
+  }
 }
 
 }  // namespace

@@ -14,6 +14,10 @@
 #if PLIANT_CONSUMER_VISION
 #include <pliant/vision/depth_cloud.hpp>
 #endif
+#if PLIANT_CONSUMER_WEBCAM
+#include <pliant/vision/webcam_error.hpp>
+#include <pliant/vision/webcam_frames.hpp>
+#endif
 #if PLIANT_CONSUMER_SOCKETCAN
 #include <pliant/drivers/socketcan/ati_netcanoem_protocol.hpp>
 #endif
@@ -21,6 +25,8 @@
 #include <pliant/drivers/modbus/modbus_crc.hpp>
 #endif
 #if PLIANT_CONSUMER_OPENCV
+#include <pliant/drivers/opencv/file_readers.hpp>
+#include <pliant/drivers/opencv/image_files.hpp>
 #include <pliant/drivers/opencv/opencv_camera.hpp>
 #endif
 #if PLIANT_CONSUMER_LIBCAMERA
@@ -67,6 +73,16 @@ int main(int argc, char** argv) {
   pliant::vision::DepthCloud cloud;
   expect(pliant::vision::depth_to_cloud(image, intrinsics, {}, cloud) == 12, "vision: 12 points from a 4x3 image");
 #endif
+#if PLIANT_CONSUMER_WEBCAM
+  // The webcam front end lists sequences through the opencv driver (a link the export carries).
+  bool refused = false;
+  try {
+    pliant::vision::webcam::expand_image_pattern("/nonexistent/pliant/*.png");
+  } catch (const pliant::vision::webcam::InputError& e) {
+    refused = std::string(e.what()).find("no file matches") != std::string::npos;
+  }
+  expect(refused, "vision: webcam glob that matches nothing refused");
+#endif
 #if PLIANT_CONSUMER_SOCKETCAN
   namespace ati = pliant::drivers::socketcan::ati;
   expect(ati::valid_base_id(0x20), "socketcan: ATI base ID 0x20 valid");
@@ -78,6 +94,16 @@ int main(int argc, char** argv) {
 #if PLIANT_CONSUMER_OPENCV
   expect(std::string(pliant::drivers::opencv_source_name(pliant::drivers::OpenCvSource::video_file)).size() > 0,
          "opencv: source names");
+  {
+    namespace files = pliant::drivers::opencv_files;
+    files::SequencePattern pattern;
+    std::string words;
+    expect(
+        files::parse_sequence_pattern("f_%03d.png", pattern, words) && files::sequence_name(pattern, 7) == "f_007.png",
+        "opencv: image sequence naming");
+    expect(files::read_image("/nonexistent/pliant.png", files::ImageDecoding::as_stored).empty(),
+           "opencv: a missing image reads empty");
+  }
 #endif
 #if PLIANT_CONSUMER_LIBCAMERA
   std::string error;

@@ -7,6 +7,7 @@
 
 #include <opencv2/core/mat.hpp>
 
+#include "pliant/drivers/opencv/image_files.hpp"
 #include "pliant/drivers/opencv/opencv_camera.hpp"
 #include "pliant/hal/status.hpp"
 
@@ -33,11 +34,9 @@ class FrameSource {
   virtual SourceStatus next(cv::Mat& image, double& media_s) = 0;
 };
 
-/// Why open() failed: the HAL status configure returns, and words for last_error().
-struct OpenError {
-  hal::HalStatus status = hal::HalStatus::io_error;
-  std::string message;
-};
+/// Why open() failed: the HAL status configure returns, and words for last_error() (the file
+/// readers' error type, so their messages pass through unchanged).
+using OpenError = opencv_files::FileError;
 
 class SourceFactory {
  public:

@@ -1,9 +1,11 @@
-#include "image_sequence.hpp"
+// Naming of image sequences: patterns parsed by hand, natural order, image extensions. Pure
+// functions (the fuzz target compiles this file alone).
+#include "pliant/drivers/opencv/image_files.hpp"
 
 #include <cctype>
 #include <cstddef>
 
-namespace pliant::drivers::opencv_detail {
+namespace pliant::drivers::opencv_files {
 
 namespace {
 
@@ -63,7 +65,7 @@ bool parse_sequence_pattern(std::string_view pattern, SequencePattern& out, std:
     i = j;
   }
   if (conversions == 0) {
-    error = "image pattern: no %d conversion (and not a directory)";
+    error = "image pattern: no %d conversion (and not a directory or a glob)";
     return false;
   }
   out = std::move(parsed);
@@ -129,4 +131,6 @@ bool has_image_extension(std::string_view name) noexcept {
   return false;
 }
 
-}  // namespace pliant::drivers::opencv_detail
+bool has_glob_characters(std::string_view name) noexcept { return name.find_first_of("*?[") != std::string_view::npos; }
+
+}  // namespace pliant::drivers::opencv_files

@@ -17,6 +17,7 @@
 #include "convert.hpp"
 #include "frame_ring.hpp"
 #include "frame_source.hpp"
+#include "pliant/drivers/opencv/image_files.hpp"
 
 namespace pliant::drivers {
 
@@ -50,7 +51,7 @@ void bump(std::atomic<std::uint64_t>& counter, std::uint64_t by = 1) noexcept {
 const char* config_problem(const OpenCvCameraConfig& c) noexcept {
   if (c.location.empty()) return "location is empty";
   if (c.width < 0 || c.width > kMaxSide || c.height < 0 || c.height > kMaxSide) return "width/height outside 0..16384";
-  if (!std::isfinite(c.fps) || c.fps < 0 || c.fps > 1000) return "fps outside [0, 1000]";
+  if (!(c.fps == 0 || opencv_files::valid_file_rate(c.fps))) return "fps outside [0, 1000]";
   if (c.first_index < -1) return "first_index below -1";
   if (c.ring_frames < 2 || c.ring_frames > 64) return "ring_frames outside 2..64";
   if (!(c.reconnect_interval_s > 0 && c.reconnect_interval_s <= 60)) return "reconnect_interval_s outside (0, 60]";

@@ -1,6 +1,4 @@
-// Video files and V4L2 devices through cv::VideoCapture.
-#include <unistd.h>
-
+// Video files (the shared reader of file_readers.hpp) and V4L2 devices through cv::VideoCapture.
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -11,6 +9,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "frame_source.hpp"
+#include "pliant/drivers/opencv/file_readers.hpp"
 #include "sources.hpp"
 
 namespace pliant::drivers::opencv_detail {
@@ -21,13 +20,14 @@ namespace fs = std::filesystem;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+// A video file through the shared reader (file_readers.hpp), with the camera's media clock.
 class VideoFileSource final : public FrameSource {
  public:
-  VideoFileSource(cv::VideoCapture capture, double fps, double announced_frames)
-      : capture_(std::move(capture)), fps_(fps), announced_(announced_frames) {}
+  VideoFileSource(std::unique_ptr<opencv_files::VideoFile> video, double fps)
+      : video_(std::move(video)), fps_(fps), announced_(video_->stated_frames()) {}
 
   SourceStatus next(cv::Mat& image, double& media_s) override {
-    if (!capture_.read(image) || image.empty()) {
+    if (!video_->read(image)) {
       // Container frame counts may be estimates from the duration: a one-frame shortfall is
       // not reported.
       return (announced_ > 0 && static_cast<double>(frames_) + 1 < announced_) ? SourceStatus::ended_early
@@ -36,7 +36,7 @@ class VideoFileSource final : public FrameSource {
     ++frames_;
     // The backend's position after a read is the frame's presentation time; use it while it
     // increases, else continue from the previous frame at the nominal rate.
-    const double position_s = capture_.get(cv::CAP_PROP_POS_MSEC) / 1000.0;
+    const double position_s = video_->position_s();
     double t = 0;
     if (has_last_) {
       t = (std::isfinite(position_s) && position_s > last_s_) ? position_s : last_s_ + 1.0 / fps_;
@@ -50,7 +50,7 @@ class VideoFileSource final : public FrameSource {
   }
 
  private:
-  cv::VideoCapture capture_;
+  std::unique_ptr<opencv_files::VideoFile> video_;
   double fps_;
   double announced_;
   std::uint64_t frames_ = 0;
@@ -64,29 +64,10 @@ class VideoFileFactory final : public SourceFactory {
   bool live() const noexcept override { return false; }
 
   std::unique_ptr<FrameSource> open(OpenError& error) override {
-    error.status = hal::HalStatus::io_error;
-    std::error_code ec;
-    if (!fs::exists(path_, ec)) {
-      error.message = "video file " + path_ + ": no such file";
-      return nullptr;
-    }
-    if (!fs::is_regular_file(path_, ec)) {
-      error.message = "video file " + path_ + ": not a regular file";
-      return nullptr;
-    }
-    if (::access(path_.c_str(), R_OK) != 0) {
-      error.message = "video file " + path_ + ": not readable (permissions)";
-      return nullptr;
-    }
-    cv::VideoCapture capture;
-    if (!capture.open(path_, cv::CAP_FFMPEG) && !capture.open(path_, cv::CAP_OPENCV_MJPEG)) {
-      error.message = "video file " + path_ + ": OpenCV cannot decode it (FFmpeg and MJPEG backends tried)";
-      return nullptr;
-    }
-    double fps = capture.get(cv::CAP_PROP_FPS);
-    if (!std::isfinite(fps) || fps <= 0 || fps > 1000) fps = fallback_fps_;
-    const double announced = capture.get(cv::CAP_PROP_FRAME_COUNT);
-    return std::make_unique<VideoFileSource>(std::move(capture), fps, std::isfinite(announced) ? announced : 0.0);
+    std::unique_ptr<opencv_files::VideoFile> video = opencv_files::VideoFile::open(path_, error);
+    if (!video) return nullptr;
+    const double fps = video->stated_fps() > 0 ? video->stated_fps() : fallback_fps_;
+    return std::make_unique<VideoFileSource>(std::move(video), fps);
   }
 
  private:

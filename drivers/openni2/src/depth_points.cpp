@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstring>
 
+#include "pliant/hal/depth_projection.hpp"
+
 namespace pliant::drivers::openni2 {
 namespace {
 
@@ -65,27 +67,18 @@ PointsResult back_project(const std::uint8_t* depth, std::size_t depth_bytes, in
     result.status = PointsStatus::output_too_small;
     return result;
   }
-  const Scalar nan = std::numeric_limits<Scalar>::quiet_NaN();
-  const double inverse_fx = 1.0 / k.fx;
-  const double inverse_fy = 1.0 / k.fy;
+  // The HAL's back-projection (depth_projection.hpp): an organised cloud, NaN where raw is 0.
+  const hal::DepthRaster raster{depth, stride_bytes};
+  const hal::DepthPinhole pinhole{k.fx, k.fy, k.cx, k.cy, depth_scale_m};
+  const hal::DepthWindow window{0, 0, width, height, 1};
   Scalar* point = out;
-  for (int v = 0; v < height; ++v) {
-    const std::uint8_t* row = depth + static_cast<std::size_t>(v) * stride_bytes;
-    const double ray_y = (static_cast<double>(v) - k.cy) * inverse_fy;
-    for (int u = 0; u < width; ++u, point += 3) {
-      std::uint16_t raw = 0;
-      std::memcpy(&raw, row + 2 * static_cast<std::size_t>(u), sizeof raw);
-      if (raw == 0) {
-        point[0] = point[1] = point[2] = nan;
-        continue;
-      }
-      const double z = static_cast<double>(raw) * depth_scale_m;
-      point[0] = static_cast<Scalar>((static_cast<double>(u) - k.cx) * inverse_fx * z);
-      point[1] = static_cast<Scalar>(ray_y * z);
-      point[2] = static_cast<Scalar>(z);
-      ++result.valid_points;
-    }
-  }
+  hal::back_project_depth(raster, pinhole, window, [&](const hal::DepthPoint& p) noexcept {
+    point[0] = static_cast<Scalar>(p.x);
+    point[1] = static_cast<Scalar>(p.y);
+    point[2] = static_cast<Scalar>(p.z);
+    point += 3;
+    if (p.raw != 0) ++result.valid_points;
+  });
   return result;
 }
 

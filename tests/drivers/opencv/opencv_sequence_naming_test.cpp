@@ -5,9 +5,9 @@
 #include <string>
 #include <vector>
 
-#include "image_sequence.hpp"
+#include "pliant/drivers/opencv/image_files.hpp"
 
-namespace pliant::drivers::opencv_detail {
+namespace pliant::drivers::opencv_files {
 namespace {
 
 SequencePattern parse_ok(const std::string& text) {
@@ -73,4 +73,4 @@ TEST(OpenCvSequenceNaming, ImageExtensions) {
 }
 
 }  // namespace
-}  // namespace pliant::drivers::opencv_detail
+}  // namespace pliant::drivers::opencv_files

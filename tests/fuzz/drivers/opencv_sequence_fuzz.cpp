@@ -14,11 +14,11 @@
 #include <string>
 #include <string_view>
 
-#include "image_sequence.hpp"
+#include "pliant/drivers/opencv/image_files.hpp"
 
 namespace {
 
-namespace oc = pliant::drivers::opencv_detail;
+namespace oc = pliant::drivers::opencv_files;
 
 void check(bool condition) {
   if (!condition) std::abort();

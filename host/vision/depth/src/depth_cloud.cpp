@@ -4,6 +4,8 @@
 #include <limits>
 #include <string>
 
+#include "pliant/hal/depth_projection.hpp"
+
 namespace pliant::vision {
 namespace {
 
@@ -19,8 +21,10 @@ std::size_t cloud_capacity(int width, int height, const DepthToCloudOptions& opt
   if (width < 1 || height < 1 || options.stride < 1) return 0;
   const PixelRect r = region_of(options, width, height);
   if (r.width < 1 || r.height < 1) return 0;
-  const auto columns = static_cast<std::size_t>((r.width + options.stride - 1) / options.stride);
-  const auto rows = static_cast<std::size_t>((r.height + options.stride - 1) / options.stride);
+  // In 64 bits: a stride near INT_MAX must not overflow the rounding up.
+  const long long stride = options.stride;
+  const auto columns = static_cast<std::size_t>((r.width + stride - 1) / stride);
+  const auto rows = static_cast<std::size_t>((r.height + stride - 1) / stride);
   return columns * rows;
 }
 
@@ -71,22 +75,16 @@ std::size_t depth_to_cloud_unchecked(const DepthImageView& image, const PinholeI
   const std::size_t capacity = cloud_capacity(image.width, image.height, options);
   if (out.points.capacity() < capacity) out.reserve(capacity);
   const PixelRect r = region_of(options, image.width, image.height);
-  const double scale = options.depth_scale_m;
-  const double inverse_fx = 1.0 / k.fx;
-  const double inverse_fy = 1.0 / k.fy;
-  for (int v = r.v0; v < r.v0 + r.height; v += options.stride) {
-    const double ray_y = (static_cast<double>(v) - k.cy) * inverse_fy;
-    const std::uint16_t* row = image.data + static_cast<std::size_t>(v) * image.stride();
-    for (int u = r.u0; u < r.u0 + r.width; u += options.stride) {
-      const std::uint16_t raw = row[u];
-      if (raw == 0) continue;
-      const double z = static_cast<double>(raw) * scale;
-      if (z < options.min_depth_m || z > options.max_depth_m) continue;
-      const double x = (static_cast<double>(u) - k.cx) * inverse_fx * z;
-      out.points.emplace_back(static_cast<float>(x), static_cast<float>(ray_y * z), static_cast<float>(z));
-      out.pixel.push_back(v * image.width + u);
-    }
-  }
+  // The HAL's back-projection (hal/depth_projection.hpp), the one the depth drivers use.
+  const hal::DepthRaster raster{reinterpret_cast<const std::uint8_t*>(image.data),
+                                image.stride() * sizeof(std::uint16_t)};
+  const hal::DepthPinhole pinhole{k.fx, k.fy, k.cx, k.cy, options.depth_scale_m};
+  const hal::DepthWindow window{r.u0, r.v0, r.width, r.height, options.stride};
+  hal::back_project_depth(raster, pinhole, window, [&](const hal::DepthPoint& p) {
+    if (p.raw == 0 || p.z < options.min_depth_m || p.z > options.max_depth_m) return;
+    out.points.emplace_back(static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z));
+    out.pixel.push_back(p.v * image.width + p.u);
+  });
   return out.points.size();
 }
 

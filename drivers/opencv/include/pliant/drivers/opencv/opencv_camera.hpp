@@ -6,10 +6,14 @@
 //   video_file      a video OpenCV's FFmpeg backend can decode (else its built-in MJPEG reader).
 //   image_sequence  still images read with imgcodecs: `location` is a printf-style pattern with
 //                   exactly one integer conversion (frame_%04d.png; %d, %Nd, %0Nd; %% is a
-//                   literal percent) or a directory (every file with an image extension, in
-//                   natural name order: 2.png before 10.png). A pattern sequence starts at
-//                   `first_index` (-1: 0, else 1, whichever file exists) and ends at the first
-//                   missing index.
+//                   literal percent), a glob (frames/*.png: byte order of the names) or a
+//                   directory (every file with an image extension, in natural name order: 2.png
+//                   before 10.png). A pattern sequence starts at `first_index` (-1: 0, else 1,
+//                   whichever file exists) and ends at the first missing index. The files are
+//                   listed at configure (image_files.hpp); one that has gone by its turn ends
+//                   the sequence.
+// Video files and image sequences are read by the driver's file readers (file_readers.hpp,
+// image_files.hpp), which the webcam front end uses too.
 //
 // Frames: every frame is converted to `format` (rgb8, bgr8 or mono8) into a ring of
 // `ring_frames` slots allocated at configure and sized from the first frame, which configure

@@ -33,21 +33,25 @@ class FrameSource {
   virtual const std::string& name() const = 0;
 };
 
-/// Opens `input`:
-///   - a printf-style pattern with one integer field ("frames/f_%04d.png"): the files for
-///     consecutive numbers from 0 (or from 1 when 0 does not exist) up to the first gap;
+/// Opens `input` through the opencv driver's file readers (pliant/drivers/opencv/image_files.hpp
+/// and file_readers.hpp, the one reader of files in pliant), unless it is an existing file:
+///   - a printf-style pattern with one integer conversion ("frames/f_%04d.png"; %d, %i, %u with
+///     an optional '0' flag and width, %% a literal '%'): the files for consecutive numbers from
+///     0 (or from 1 when 0 does not exist) up to the first gap;
 ///   - a glob ("frames/*.png", any of * ? [): the matching files in byte order of their names;
-///   - otherwise a video file (OpenCV's FFmpeg back end).
+///   - otherwise a video file (OpenCV's FFmpeg back end, else its MJPEG reader).
 /// `fps_hz` > 0 sets the frame rate (overriding a video's); 0 takes a video's own rate, and
-/// `sequence_fps_hz` for an image sequence (which has none; 0 then refuses the sequence).
-/// Throws InputError when nothing can be opened: no matching file, a missing or unreadable
-/// video, a video without a stated rate and no `fps_hz`, a rate that is not finite and > 0.
+/// `sequence_fps_hz` for an image sequence (which has none; 0 then refuses the sequence). Rates
+/// are finite, > 0 and at most 1000 Hz (drivers::opencv_files::valid_file_rate).
+/// Throws InputError when nothing can be opened: no matching file, a missing, unreadable or
+/// undecodable video, a directory, a video without a stated rate and no `fps_hz`, a rate out of
+/// range. The message is the reader's, one line naming the input.
 std::unique_ptr<FrameSource> open_frame_source(const std::string& input, double fps_hz, double sequence_fps_hz = 0);
 
 /// Frames held in memory (tests, callers that decode themselves). Reads copies.
 class MemoryFrameSource final : public FrameSource {
  public:
-  /// Throws InputError unless fps_hz is finite and > 0.
+  /// Throws InputError unless fps_hz is finite, > 0 and at most 1000 Hz.
   MemoryFrameSource(std::vector<cv::Mat> frames, double fps_hz, std::string name = "memory");
   bool read(cv::Mat& image, std::string& label) override;
   double fps() const override { return fps_; }
