@@ -45,6 +45,14 @@ void catmull_rom(double t, double w[4]) {
   w[3] = 0.5 * (t3 - t2);
 }
 
+// Linear interpolation between the nodes 0 and 1 in the same four-node form.
+void linear_weights(double t, double w[4]) {
+  w[0] = 0;
+  w[1] = 1 - t;
+  w[2] = t;
+  w[3] = 0;
+}
+
 }  // namespace
 
 PressScene::PressScene(const PressSceneConfig& config) : config_(config) {
@@ -139,8 +147,13 @@ cv::Point2d PressScene::displacement(int frame, const cv::Point2d& u) const {
   const int ix = std::clamp(static_cast<int>(std::floor(tx)), -1, cols - 1);
   const int iy = std::clamp(static_cast<int>(std::floor(ty)), -1, rows - 1);
   double wx[4], wy[4];
-  catmull_rom(tx - ix, wx);
-  catmull_rom(ty - iy, wy);
+  if (config_.bilinear) {
+    linear_weights(tx - ix, wx);
+    linear_weights(ty - iy, wy);
+  } else {
+    catmull_rom(tx - ix, wx);
+    catmull_rom(ty - iy, wy);
+  }
   cv::Point2d d(0, 0);
   for (int j = 0; j < 4; ++j) {
     cv::Point2d line(0, 0);

@@ -45,6 +45,9 @@ struct PressSceneConfig {
   double occluder_y = 0;
   double occluder_speed_px = 0;
   int occluder_from = 0;
+  /// Bilinear instead of Catmull-Rom interpolation of the displacements: a kink at every
+  /// particle, as under a tool's point of contact, where the splines round the peak off.
+  bool bilinear = false;
 };
 
 class PressScene {

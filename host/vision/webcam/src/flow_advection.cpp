@@ -41,6 +41,9 @@ void check_advection_config(const AdvectionConfig& c) {
   if (c.refine_window_px != 0 && (c.refine_window_px < 3 || c.refine_window_px > 51 || c.refine_window_px % 2 == 0)) {
     throw InputError("--refine-window must be 0 (off) or odd, 3..51 px");
   }
+  if (c.peak_refine_window_px < 3 || c.peak_refine_window_px > 51 || c.peak_refine_window_px % 2 == 0) {
+    throw InputError("the tool's refining window must be odd, 3..51 px");
+  }
   if (c.dis_finest_scale < -1 || c.dis_finest_scale > 4)
     throw InputError("DIS finest scale must be 0..4 (or -1: from the spacing)");
 }
@@ -136,17 +139,27 @@ void FlowAdvector::observe(const cv::Mat& next, const std::vector<cv::Point2d>& 
 }
 
 void FlowAdvector::refine(const std::vector<cv::Point2d>& positions) {
+  refine_with(positions, false, config_.refine_window_px);
+  if (peak_ >= 0 && static_cast<std::size_t>(peak_) < positions.size()) {
+    refine_with(positions, true, std::min(config_.peak_refine_window_px, config_.refine_window_px));
+  }
+}
+
+// Lucas-Kanade from positions to advected_ with a window_px window: the peak particle alone
+// (peak) or every other particle.
+void FlowAdvector::refine_with(const std::vector<cv::Point2d>& positions, bool peak, int window_px) {
   from_.clear();
   to_.clear();
   index_.clear();
   for (std::size_t i = 0; i < positions.size(); ++i) {
+    if ((static_cast<int>(i) == peak_) != peak) continue;
     if (!inside(previous_, positions[i]) || !inside(next_, advected_[i])) continue;
     from_.emplace_back(static_cast<float>(positions[i].x), static_cast<float>(positions[i].y));
     to_.emplace_back(static_cast<float>(advected_[i].x), static_cast<float>(advected_[i].y));
     index_.push_back(i);
   }
   if (from_.empty()) return;
-  const int w = config_.refine_window_px;
+  const int w = window_px;
   cv::calcOpticalFlowPyrLK(previous_, next_, from_, to_, lk_status_, lk_error_, cv::Size(w, w), 0,
                            cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.001),
                            cv::OPTFLOW_USE_INITIAL_FLOW);

@@ -1,6 +1,7 @@
 // Frame sources: video files and image sequences through the opencv driver's file readers (the
 // one reader of files in pliant: drivers/opencv file_readers.hpp, image_files.hpp), frames in
 // memory, and the dispatch between them.
+#include <cmath>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -15,6 +16,11 @@
 
 namespace pliant::vision::webcam {
 namespace {
+
+// A rate the user states (--fps, a sequence's rate, frames in memory): high-speed footage is
+// allowed. A rate a video container states is checked by the driver's valid_file_rate (at most
+// 1000 Hz: above that, containers report their time base, not a frame rate).
+bool valid_given_rate(double hz) { return std::isfinite(hz) && hz > 0 && hz <= 1e6; }
 
 namespace files = drivers::opencv_files;
 
@@ -92,10 +98,9 @@ std::vector<std::string> expand_image_pattern(const std::string& input) {
 }
 
 std::unique_ptr<FrameSource> open_frame_source(const std::string& input, double fps_hz, double sequence_fps_hz) {
-  if (!(fps_hz == 0 || files::valid_file_rate(fps_hz)))
-    throw InputError("--fps must be a finite rate > 0, at most 1000 Hz");
-  if (!(sequence_fps_hz == 0 || files::valid_file_rate(sequence_fps_hz)))
-    throw InputError("the image sequence rate must be > 0, at most 1000 Hz");
+  if (!(fps_hz == 0 || valid_given_rate(fps_hz))) throw InputError("--fps must be a finite rate > 0, at most 1e6 Hz");
+  if (!(sequence_fps_hz == 0 || valid_given_rate(sequence_fps_hz)))
+    throw InputError("the image sequence rate must be > 0, at most 1e6 Hz");
   if (input.empty()) throw InputError("no video or image pattern given");
   std::vector<std::string> paths = expand_image_pattern(input);
   if (!paths.empty()) {
@@ -108,8 +113,7 @@ std::unique_ptr<FrameSource> open_frame_source(const std::string& input, double 
 
 MemoryFrameSource::MemoryFrameSource(std::vector<cv::Mat> frames, double fps_hz, std::string name)
     : frames_(std::move(frames)), fps_(fps_hz), name_(std::move(name)) {
-  if (!files::valid_file_rate(fps_hz))
-    throw InputError(name_ + ": the frame rate must be finite, > 0 and at most 1000 Hz");
+  if (!valid_given_rate(fps_hz)) throw InputError(name_ + ": the frame rate must be finite, > 0 and at most 1e6 Hz");
 }
 
 bool MemoryFrameSource::read(cv::Mat& image, std::string& label) {

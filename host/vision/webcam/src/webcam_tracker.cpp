@@ -74,6 +74,34 @@ void build_tracker(const ParticleGrid& grid, const TrackOptions& options, Tracke
   if (tracker_status != Status::ok) throw InputError(status_text("tracker settings refused", tracker_status));
 }
 
+// Per particle, its largest distance from its seed in the frames where the camera saw it. Where
+// it was not seen the tracker's position is the MSM prior's guess, run without any support
+// (roles are chosen from this motion), and can drift: a still base whose particles are often
+// unseen at the object's edge would look as if it moved. A particle never seen keeps the
+// largest distance of its tracked positions.
+std::vector<double> observed_motion(const TrackResult& result) {
+  const int n = result.particle_count();
+  std::vector<double> seen_motion(static_cast<std::size_t>(n), 0.0);
+  std::vector<double> any_motion(static_cast<std::size_t>(n), 0.0);
+  std::vector<bool> ever_seen(static_cast<std::size_t>(n), false);
+  for (int f = 0; f < result.frame_count(); ++f) {
+    for (int i = 0; i < n; ++i) {
+      const std::size_t k = static_cast<std::size_t>(i);
+      const cv::Point2d d = result.tracked[result.at(f, i)] - result.grid.positions[k];
+      const double distance = std::hypot(d.x, d.y);
+      any_motion[k] = std::max(any_motion[k], distance);
+      if (f == 0 || result.observed[result.at(f, i)] != 0) {
+        seen_motion[k] = std::max(seen_motion[k], distance);
+        if (f > 0) ever_seen[k] = true;
+      }
+    }
+  }
+  for (std::size_t k = 0; k < seen_motion.size(); ++k) {
+    if (!ever_seen[k]) seen_motion[k] = any_motion[k];
+  }
+  return seen_motion;
+}
+
 }  // namespace
 
 void check_track_options(const TrackOptions& options) {
@@ -175,11 +203,6 @@ TrackResult track_particles(FrameReader& reader, const Region& region, const Gri
       const Vec2 guess = tracker.state.position[i] + dt * tracker.state.velocity[i];
       predicted[i] = cv::Point2d(guess(0), guess(1));
     }
-    advector.observe(frame.grey, positions, predicted, seen, observations);
-    for (std::size_t i = 0; i < count; ++i) {
-      const ParticleObservation& o = observations[i];
-      observed[i] = o.usable() ? Vec2(o.position.x, o.position.y) : Vec2(kNaN, kNaN);
-    }
     int tool = given_tool;
     if (tool < 0) {
       double farthest = kToolMotionPx;
@@ -190,6 +213,12 @@ TrackResult track_particles(FrameReader& reader, const Region& region, const Gri
           tool = id;
         }
       }
+    }
+    advector.set_peak(tool);
+    advector.observe(frame.grey, positions, predicted, seen, observations);
+    for (std::size_t i = 0; i < count; ++i) {
+      const ParticleObservation& o = observations[i];
+      observed[i] = o.usable() ? Vec2(o.position.x, o.position.y) : Vec2(kNaN, kNaN);
     }
     Vec2 tool_target = Vec2::Zero();
     TrackerFrame<2, double> in;
@@ -218,14 +247,7 @@ TrackResult track_particles(FrameReader& reader, const Region& region, const Gri
   }
   result.counters = tracker.counters;
 
-  result.motion_px.assign(count, 0.0);
-  for (int f = 0; f < result.frame_count(); ++f) {
-    for (int i = 0; i < n; ++i) {
-      const cv::Point2d d = result.tracked[result.at(f, i)] - grid.positions[static_cast<std::size_t>(i)];
-      double& m = result.motion_px[static_cast<std::size_t>(i)];
-      m = std::max(m, std::hypot(d.x, d.y));
-    }
-  }
+  result.motion_px = observed_motion(result);
   result.roles = choose_roles(grid, result.motion_px, options.support, options.driven);
   return result;
 }

@@ -7,8 +7,9 @@
 //      at q) over a refine_window_px window at full resolution. Dense flow is regularised over
 //      its patches (DIS: 8 x 2^s px) and so flattens a sharp displacement peak such as the one
 //      under a tool, a bias that accumulates frame after frame and pushes msm_beta up; the small
-//      LK window follows the peak. A refinement that fails (LK status) or moves q by more than
-//      half its window keeps the eq. 14 position;
+//      LK window follows the peak, and the particle under the tool (set_peak), where the
+//      displacement peaks, gets a narrower one still. A refinement that fails (LK status) or
+//      moves q by more than half its window keeps the eq. 14 position;
 //   2. forward-backward: the backward flow (next -> previous) averaged around q should bring q
 //      back to p; e = |q + o_back(q) - p| above fb_threshold_px marks the flow there unreliable
 //      (occlusion boundaries, flow errors);
@@ -56,6 +57,11 @@ struct AdvectionConfig {
   /// Side of the Lucas-Kanade window that refines each advected position at full resolution
   /// (step 1b); 0 turns the refinement off (eq. 14 alone). Odd, 3..51 otherwise.
   int refine_window_px = 9;
+  /// Side of the refining window for the particle under the tool (set_peak): the displacement
+  /// peaks there, and a window averages the peak down by about its curvature times the window's
+  /// area, every frame, so the tool's path comes out short and msm_beta high. Odd, 3..51, at
+  /// most refine_window_px.
+  int peak_refine_window_px = 3;
 };
 
 /// Throws InputError naming the first field out of range.
@@ -97,6 +103,10 @@ class FlowAdvector {
                const std::vector<cv::Point2d>& predicted, const std::vector<std::uint8_t>& seen,
                std::vector<ParticleObservation>& out);
 
+  /// The particle at the peak of the displacement (the tool's contact; -1: none), refined with
+  /// peak_refine_window_px from the next observe() on.
+  void set_peak(int particle) { peak_ = particle; }
+
   /// Ends the frame: the templates of particles with refresh[i] != 0 are retaken from `next` at
   /// positions[i] (their corrected positions), and `next` becomes the previous frame.
   void commit(const std::vector<cv::Point2d>& positions, const std::vector<std::uint8_t>& refresh);
@@ -107,6 +117,7 @@ class FlowAdvector {
 
  private:
   void refine(const std::vector<cv::Point2d>& positions);
+  void refine_with(const std::vector<cv::Point2d>& positions, bool peak, int window_px);
   PatchMatch search(const cv::Mat& templ, const cv::Point2d& a, const cv::Point2d& b) const;
 
   DenseFlow flow_;
@@ -118,6 +129,7 @@ class FlowAdvector {
   std::vector<cv::Point2f> from_, to_;  // calcOpticalFlowPyrLK's points
   std::vector<std::size_t> index_;      // particle of each LK point
   std::vector<unsigned char> lk_status_;
+  int peak_ = -1;
   std::vector<float> lk_error_;
 };
 

@@ -65,7 +65,7 @@ struct TrackResult {
   std::vector<std::uint8_t> status;    ///< TrackStatus after the frame
   std::vector<float> fb_error_px;      ///< NaN when not computed
   std::vector<float> similarity;       ///< NaN when not computed
-  std::vector<double> motion_px;       ///< per particle: largest distance from its seed
+  std::vector<double> motion_px;       ///< per particle: largest distance from its seed where seen
   ParticleRoles roles;
   TrackerCounters counters;
   TrackOptions options;  ///< as used (progress callback cleared)
