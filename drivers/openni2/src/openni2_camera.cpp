@@ -49,6 +49,109 @@ double depth_scale_of(openni::PixelFormat format) noexcept {
 
 std::string extended_error() { return openni::OpenNI::getExtendedError(); }
 
+// Sets `error` to the reason a configuration is refused; returns invalid_argument.
+HalStatus invalid_config(std::string& error, const std::string& why) {
+  error = "invalid configuration: " + why;
+  return HalStatus::invalid_argument;
+}
+
+// Fallback intrinsics are given unless every one of fx, fy, cx, cy is NaN.
+bool has_fallback_intrinsics(const DepthIntrinsics& fallback) noexcept {
+  return !(std::isnan(fallback.fx) && std::isnan(fallback.fy) && std::isnan(fallback.cx) && std::isnan(fallback.cy));
+}
+
+// The configuration's own ranges (the header's), before OpenNI2 is touched.
+HalStatus check_config(const Openni2CameraConfig& c, std::string& error) {
+  if (c.location.empty()) return invalid_config(error, "location is empty");
+  if (!in_open_low(c.playback_speed, 0, 16)) return invalid_config(error, "playback_speed must be in (0, 16]");
+  if (c.width < 0 || c.width > kMaxDepthSide || c.height < 0 || c.height > kMaxDepthSide) {
+    return invalid_config(error, "width and height must be in 0.." + std::to_string(kMaxDepthSide));
+  }
+  if (c.fps < 0 || c.fps > 1000) return invalid_config(error, "fps must be in 0..1000");
+  if (!in_open_low(c.step_timeout_s, 0, 60)) return invalid_config(error, "step_timeout_s must be in (0, 60]");
+  if (!in_open_low(c.stall_timeout_s, 0, 600)) return invalid_config(error, "stall_timeout_s must be in (0, 600]");
+  if (!in_range(c.teardown_grace_s, 0, 5)) return invalid_config(error, "teardown_grace_s must be in [0, 5]");
+  if (c.source == Openni2Source::device && c.playback == Openni2Playback::stepped) {
+    return invalid_config(error, "stepped playback is for recordings only");
+  }
+  const DepthIntrinsics& fallback = c.fallback_intrinsics;
+  if (has_fallback_intrinsics(fallback) && check_intrinsics(fallback) != IntrinsicsCheck::ok) {
+    return invalid_config(error,
+                          std::string("fallback_intrinsics: ") + intrinsics_check_name(check_intrinsics(fallback)));
+  }
+  return HalStatus::ok;
+}
+
+// Recordings: `location` as OpenNI2's URI (absolute, normalised, at most 255 bytes), checked by
+// check_oni_file (into `info` and `check`) before OpenNI2 parses it; `depth` is its first depth
+// node, pointing into `info`.
+HalStatus check_recording(const std::string& location, std::string& uri, OniFileInfo& info, OniCheck& check,
+                          const OniNodeInfo*& depth, std::string& error) {
+  std::error_code ec;
+  std::filesystem::path path = std::filesystem::absolute(location, ec);
+  if (ec) return invalid_config(error, "cannot resolve the path \"" + location + "\"");
+  uri = path.lexically_normal().string();
+  if (uri.size() > 255) {
+    return invalid_config(error, "recording path longer than OpenNI2's 255-byte URI limit: " + uri);
+  }
+  const OniCheckResult result = check_oni_file(uri, info);
+  check = result.status;
+  if (!result.ok()) {
+    error = "recording refused: " + result.message;
+    return HalStatus::io_error;
+  }
+  depth = info.first_node_of_type(kOniNodeDepth);
+  if (depth == nullptr) {
+    error = "recording \"" + uri + "\" has no depth stream";
+    return HalStatus::io_error;
+  }
+  return HalStatus::ok;
+}
+
+// Devices: the URI to open. "any" is the first device OpenNI2 enumerates that is a USB camera
+// (not a Dummy URI, not a recording opened earlier); disconnected when there is none. OpenNI2
+// must be initialised.
+HalStatus resolve_device_uri(const std::string& location, std::string& uri, std::string& error) {
+  uri = location;
+  if (uri != "any") return HalStatus::ok;
+  openni::Array<openni::DeviceInfo> devices;
+  openni::OpenNI::enumerateDevices(&devices);
+  uri.clear();
+  for (int i = 0; i < devices.getSize() && uri.empty(); ++i) {
+    const char* candidate = devices[i].getUri();
+    if (candidate == nullptr || is_dummy_uri(candidate) || devices[i].getUsbVendorId() == 0) continue;
+    std::error_code ec;
+    if (std::filesystem::exists(candidate, ec)) continue;  // a recording opened earlier
+    uri = candidate;
+  }
+  if (uri.empty()) {
+    error = "no OpenNI2 depth camera connected (OpenNI2 enumerates " + std::to_string(devices.getSize()) +
+            " device(s), none a USB camera; the Dummy test device must be opened by URI \"Dummy\")";
+    return HalStatus::disconnected;
+  }
+  return HalStatus::ok;
+}
+
+// Devices: the index among `modes` of the depth mode matching the requested width, height and fps
+// (0: any), millimetres preferred; -1 when none matches.
+int matching_depth_mode(const openni::Array<openni::VideoMode>& modes, const Openni2CameraConfig& c) {
+  int chosen = -1;
+  for (int i = 0; i < modes.getSize(); ++i) {
+    const openni::VideoMode& mode = modes[i];
+    if (depth_scale_of(mode.getPixelFormat()) == 0) continue;
+    if ((c.width != 0 && mode.getResolutionX() != c.width) || (c.height != 0 && mode.getResolutionY() != c.height) ||
+        (c.fps != 0 && mode.getFps() != c.fps)) {
+      continue;
+    }
+    // Prefer millimetres, then the current format.
+    if (chosen < 0 || (mode.getPixelFormat() == openni::PIXEL_FORMAT_DEPTH_1_MM &&
+                       modes[chosen].getPixelFormat() != openni::PIXEL_FORMAT_DEPTH_1_MM)) {
+      chosen = i;
+    }
+  }
+  return chosen;
+}
+
 }  // namespace
 
 struct Openni2Camera::Impl {
@@ -96,6 +199,15 @@ struct Openni2Camera::Impl {
   std::uint64_t last_sequence = 0;
 
   DepthIntrinsics no_intrinsics;
+
+  // Configure steps (configure_impl runs them in this order). Each returns ok, or a status with
+  // the reason in `error`; objects created so far stay for teardown.
+  HalStatus open_device(const std::string& uri, std::string& error);
+  HalStatus set_playback(double playback_speed, const std::string& uri, std::string& error);
+  HalStatus create_depth_stream(const std::string& uri, std::string& error);
+  HalStatus select_depth_mode(const Openni2CameraConfig& c, const std::string& uri, std::string& error);
+  HalStatus adopt_depth_mode(const std::string& uri, std::string& error);
+  HalStatus choose_intrinsics(const DepthIntrinsics& fallback, std::string& error);
 
   void stop_stream() noexcept {
     if (!stream_running) return;
@@ -162,31 +274,125 @@ HalStatus Openni2Camera::on_configure() {
   return status;
 }
 
+// Opens `uri` (a device or a recording, as `recording` says) and listens to its events.
+HalStatus Openni2Camera::Impl::open_device(const std::string& uri, std::string& error) {
+  if (device.open(uri.c_str()) != openni::STATUS_OK) {
+    error = "OpenNI2 cannot open \"" + uri + "\": " + extended_error();
+    return recording ? HalStatus::io_error : HalStatus::disconnected;
+  }
+  device_open = true;
+  dummy = !recording && is_dummy_uri(uri.c_str());
+  if (device.isFile() != recording) {
+    error = recording ? "\"" + uri + "\" did not open as a recording" : "\"" + uri + "\" is a recording, not a device";
+    return HalStatus::invalid_argument;
+  }
+  events = std::make_unique<detail::DeviceEvents>(device.getDeviceInfo().getUri());
+  if (!events->attach()) {
+    error = "OpenNI2 refused the device event listener: " + extended_error();
+    return HalStatus::io_error;
+  }
+  return HalStatus::ok;
+}
+
+// Recordings: no repeat, and the speed (stepped: -1, frame by frame). Before the stream exists,
+// so that the player never starts in its default repeat mode.
+HalStatus Openni2Camera::Impl::set_playback(double playback_speed, const std::string& uri, std::string& error) {
+  openni::PlaybackControl* playback = device.getPlaybackControl();
+  if (playback == nullptr || playback->setRepeatEnabled(false) != openni::STATUS_OK ||
+      playback->setSpeed(stepped ? -1.0f : static_cast<float>(playback_speed)) != openni::STATUS_OK) {
+    error = "OpenNI2 refused the playback settings for \"" + uri + "\": " + extended_error();
+    return HalStatus::io_error;
+  }
+  return HalStatus::ok;
+}
+
+HalStatus Openni2Camera::Impl::create_depth_stream(const std::string& uri, std::string& error) {
+  if (device.getSensorInfo(openni::SENSOR_DEPTH) == nullptr ||
+      stream.create(device, openni::SENSOR_DEPTH) != openni::STATUS_OK) {
+    error = "\"" + uri + "\" has no depth sensor: " + extended_error();
+    return HalStatus::unsupported;
+  }
+  stream_created = true;
+  return HalStatus::ok;
+}
+
+// Devices with a requested width, height or fps: switches the stream to the matching depth mode
+// (matching_depth_mode) unless it is already in it.
+HalStatus Openni2Camera::Impl::select_depth_mode(const Openni2CameraConfig& c, const std::string& uri,
+                                                 std::string& error) {
+  const openni::SensorInfo& sensor = stream.getSensorInfo();
+  const openni::Array<openni::VideoMode>& modes = sensor.getSupportedVideoModes();
+  const openni::VideoMode current = stream.getVideoMode();
+  const int chosen = matching_depth_mode(modes, c);
+  if (chosen < 0) {
+    error = "\"" + uri + "\" has no millimetre depth mode " + std::to_string(c.width) + "x" + std::to_string(c.height) +
+            " @ " + std::to_string(c.fps) + " Hz (0: any)";
+    return HalStatus::unsupported;
+  }
+  const openni::VideoMode& mode = modes[chosen];
+  const bool same = mode.getResolutionX() == current.getResolutionX() &&
+                    mode.getResolutionY() == current.getResolutionY() && mode.getFps() == current.getFps() &&
+                    mode.getPixelFormat() == current.getPixelFormat();
+  if (!same && stream.setVideoMode(mode) != openni::STATUS_OK) {
+    error = "\"" + uri + "\" refused the depth mode: " + extended_error();
+    return HalStatus::unsupported;
+  }
+  return HalStatus::ok;
+}
+
+// The stream's mode as it is: format and depth scale (m per unit), size (1..kMaxDepthSide px).
+HalStatus Openni2Camera::Impl::adopt_depth_mode(const std::string& uri, std::string& error) {
+  const openni::VideoMode mode = stream.getVideoMode();
+  format = mode.getPixelFormat();
+  depth_scale_m = depth_scale_of(format);
+  if (depth_scale_m == 0) {
+    error = "\"" + uri + "\" streams depth in pixel format " + std::to_string(static_cast<int>(format)) +
+            ", not DEPTH_1_MM or DEPTH_100_UM";
+    return HalStatus::unsupported;
+  }
+  width = mode.getResolutionX();
+  height = mode.getResolutionY();
+  if (width < 1 || height < 1 || width > kMaxDepthSide || height > kMaxDepthSide) {
+    error = "\"" + uri + "\" reports a depth size of " + std::to_string(width) + "x" + std::to_string(height);
+    return HalStatus::unsupported;
+  }
+  return HalStatus::ok;
+}
+
+// Intrinsics from the stream's field of view (rad) when it reports a valid one, else the
+// fallback (given: it must be for the stream's size), else none (NaN, the stream's size).
+HalStatus Openni2Camera::Impl::choose_intrinsics(const DepthIntrinsics& fallback, std::string& error) {
+  float hfov = 0, vfov = 0;
+  const bool has_h = stream.getProperty(ONI_STREAM_PROPERTY_HORIZONTAL_FOV, &hfov) == openni::STATUS_OK;
+  const bool has_v = stream.getProperty(ONI_STREAM_PROPERTY_VERTICAL_FOV, &vfov) == openni::STATUS_OK;
+  stats.hfov_rad = has_h ? static_cast<double>(hfov) : std::numeric_limits<double>::quiet_NaN();
+  stats.vfov_rad = has_v ? static_cast<double>(vfov) : std::numeric_limits<double>::quiet_NaN();
+  DepthIntrinsics from_fov;
+  if (has_h && has_v &&
+      intrinsics_from_fov(stats.hfov_rad, stats.vfov_rad, width, height, from_fov) == IntrinsicsCheck::ok) {
+    intrinsics = from_fov;
+    stats.intrinsics_source = IntrinsicsSource::device_fov;
+  } else if (has_fallback_intrinsics(fallback)) {
+    if (fallback.width != width || fallback.height != height) {
+      return invalid_config(error, "fallback_intrinsics are for " + std::to_string(fallback.width) + "x" +
+                                       std::to_string(fallback.height) + ", the stream is " + std::to_string(width) +
+                                       "x" + std::to_string(height));
+    }
+    intrinsics = fallback;
+    stats.intrinsics_source = IntrinsicsSource::configured;
+  } else {
+    intrinsics = DepthIntrinsics{};
+    intrinsics.width = width;
+    intrinsics.height = height;
+    stats.intrinsics_source = IntrinsicsSource::none;
+  }
+  return HalStatus::ok;
+}
+
 HalStatus Openni2Camera::configure_impl() {
   const Openni2CameraConfig& c = config_;
-  const auto invalid = [this](const std::string& why) {
-    last_error_ = "invalid configuration: " + why;
-    return HalStatus::invalid_argument;
-  };
-  if (c.location.empty()) return invalid("location is empty");
-  if (!in_open_low(c.playback_speed, 0, 16)) return invalid("playback_speed must be in (0, 16]");
-  if (c.width < 0 || c.width > kMaxDepthSide || c.height < 0 || c.height > kMaxDepthSide) {
-    return invalid("width and height must be in 0.." + std::to_string(kMaxDepthSide));
-  }
-  if (c.fps < 0 || c.fps > 1000) return invalid("fps must be in 0..1000");
-  if (!in_open_low(c.step_timeout_s, 0, 60)) return invalid("step_timeout_s must be in (0, 60]");
-  if (!in_open_low(c.stall_timeout_s, 0, 600)) return invalid("stall_timeout_s must be in (0, 600]");
-  if (!in_range(c.teardown_grace_s, 0, 5)) return invalid("teardown_grace_s must be in [0, 5]");
-  if (c.source == Openni2Source::device && c.playback == Openni2Playback::stepped) {
-    return invalid("stepped playback is for recordings only");
-  }
-  const DepthIntrinsics& fallback = c.fallback_intrinsics;
-  const bool has_fallback =
-      !(std::isnan(fallback.fx) && std::isnan(fallback.fy) && std::isnan(fallback.cx) && std::isnan(fallback.cy));
-  if (has_fallback && check_intrinsics(fallback) != IntrinsicsCheck::ok) {
-    return invalid(std::string("fallback_intrinsics: ") + intrinsics_check_name(check_intrinsics(fallback)));
-  }
-
+  HalStatus status = check_config(c, last_error_);
+  if (status != HalStatus::ok) return status;
   impl_ = std::make_unique<Impl>();
   Impl& m = *impl_;
   m.recording = c.source == Openni2Source::recording;
@@ -194,160 +400,27 @@ HalStatus Openni2Camera::configure_impl() {
   m.step_timeout_s = c.step_timeout_s;
 
   std::string uri;
-  const OniNodeInfo* depth_node = nullptr;
+  const OniNodeInfo* depth_node = nullptr;  // recordings: in recording_info_
   if (m.recording) {
-    std::error_code ec;
-    std::filesystem::path path = std::filesystem::absolute(c.location, ec);
-    if (ec) return invalid("cannot resolve the path \"" + c.location + "\"");
-    uri = path.lexically_normal().string();
-    if (uri.size() > 255) return invalid("recording path longer than OpenNI2's 255-byte URI limit: " + uri);
-    const OniCheckResult check = check_oni_file(uri, recording_info_);
-    last_check_ = check.status;
-    if (!check.ok()) {
-      last_error_ = "recording refused: " + check.message;
-      return HalStatus::io_error;
-    }
-    depth_node = recording_info_.first_node_of_type(kOniNodeDepth);
-    if (depth_node == nullptr) {
-      last_error_ = "recording \"" + uri + "\" has no depth stream";
-      return HalStatus::io_error;
-    }
+    status = check_recording(c.location, uri, recording_info_, last_check_, depth_node, last_error_);
+    if (status != HalStatus::ok) return status;
     m.last_frame_number = depth_node->last_frame;
   }
-
   std::string error;
   if (!detail::ensure_openni2(error)) {
     last_error_ = error;
     return HalStatus::io_error;
   }
-
-  if (!m.recording) {
-    uri = c.location;
-    if (uri == "any") {
-      openni::Array<openni::DeviceInfo> devices;
-      openni::OpenNI::enumerateDevices(&devices);
-      uri.clear();
-      for (int i = 0; i < devices.getSize() && uri.empty(); ++i) {
-        const char* candidate = devices[i].getUri();
-        if (candidate == nullptr || is_dummy_uri(candidate) || devices[i].getUsbVendorId() == 0) continue;
-        std::error_code ec;
-        if (std::filesystem::exists(candidate, ec)) continue;  // a recording opened earlier
-        uri = candidate;
-      }
-      if (uri.empty()) {
-        last_error_ = "no OpenNI2 depth camera connected (OpenNI2 enumerates " + std::to_string(devices.getSize()) +
-                      " device(s), none a USB camera; the Dummy test device must be opened by URI \"Dummy\")";
-        return HalStatus::disconnected;
-      }
-    }
-  }
-
-  if (m.device.open(uri.c_str()) != openni::STATUS_OK) {
-    last_error_ = "OpenNI2 cannot open \"" + uri + "\": " + extended_error();
-    return m.recording ? HalStatus::io_error : HalStatus::disconnected;
-  }
-  m.device_open = true;
-  m.dummy = !m.recording && is_dummy_uri(uri.c_str());
-  if (m.device.isFile() != m.recording) {
-    last_error_ =
-        m.recording ? "\"" + uri + "\" did not open as a recording" : "\"" + uri + "\" is a recording, not a device";
-    return HalStatus::invalid_argument;
-  }
-  m.events = std::make_unique<detail::DeviceEvents>(m.device.getDeviceInfo().getUri());
-  if (!m.events->attach()) {
-    last_error_ = "OpenNI2 refused the device event listener: " + extended_error();
-    return HalStatus::io_error;
-  }
-
-  if (m.recording) {
-    // Before the stream exists, so that the player never starts in its default repeat mode.
-    openni::PlaybackControl* playback = m.device.getPlaybackControl();
-    if (playback == nullptr || playback->setRepeatEnabled(false) != openni::STATUS_OK ||
-        playback->setSpeed(m.stepped ? -1.0f : static_cast<float>(c.playback_speed)) != openni::STATUS_OK) {
-      last_error_ = "OpenNI2 refused the playback settings for \"" + uri + "\": " + extended_error();
-      return HalStatus::io_error;
-    }
-  }
-
-  if (m.device.getSensorInfo(openni::SENSOR_DEPTH) == nullptr ||
-      m.stream.create(m.device, openni::SENSOR_DEPTH) != openni::STATUS_OK) {
-    last_error_ = "\"" + uri + "\" has no depth sensor: " + extended_error();
-    return HalStatus::unsupported;
-  }
-  m.stream_created = true;
-
-  if (!m.recording && (c.width != 0 || c.height != 0 || c.fps != 0)) {
-    const openni::SensorInfo& sensor = m.stream.getSensorInfo();
-    const openni::Array<openni::VideoMode>& modes = sensor.getSupportedVideoModes();
-    const openni::VideoMode current = m.stream.getVideoMode();
-    int chosen = -1;
-    for (int i = 0; i < modes.getSize(); ++i) {
-      const openni::VideoMode& mode = modes[i];
-      if (depth_scale_of(mode.getPixelFormat()) == 0) continue;
-      if ((c.width != 0 && mode.getResolutionX() != c.width) || (c.height != 0 && mode.getResolutionY() != c.height) ||
-          (c.fps != 0 && mode.getFps() != c.fps)) {
-        continue;
-      }
-      // Prefer millimetres, then the current format.
-      if (chosen < 0 || (mode.getPixelFormat() == openni::PIXEL_FORMAT_DEPTH_1_MM &&
-                         modes[chosen].getPixelFormat() != openni::PIXEL_FORMAT_DEPTH_1_MM)) {
-        chosen = i;
-      }
-    }
-    if (chosen < 0) {
-      last_error_ = "\"" + uri + "\" has no millimetre depth mode " + std::to_string(c.width) + "x" +
-                    std::to_string(c.height) + " @ " + std::to_string(c.fps) + " Hz (0: any)";
-      return HalStatus::unsupported;
-    }
-    const openni::VideoMode& mode = modes[chosen];
-    const bool same = mode.getResolutionX() == current.getResolutionX() &&
-                      mode.getResolutionY() == current.getResolutionY() && mode.getFps() == current.getFps() &&
-                      mode.getPixelFormat() == current.getPixelFormat();
-    if (!same && m.stream.setVideoMode(mode) != openni::STATUS_OK) {
-      last_error_ = "\"" + uri + "\" refused the depth mode: " + extended_error();
-      return HalStatus::unsupported;
-    }
-  }
-
-  const openni::VideoMode mode = m.stream.getVideoMode();
-  m.format = mode.getPixelFormat();
-  m.depth_scale_m = depth_scale_of(m.format);
-  if (m.depth_scale_m == 0) {
-    last_error_ = "\"" + uri + "\" streams depth in pixel format " + std::to_string(static_cast<int>(m.format)) +
-                  ", not DEPTH_1_MM or DEPTH_100_UM";
-    return HalStatus::unsupported;
-  }
-  m.width = mode.getResolutionX();
-  m.height = mode.getResolutionY();
-  if (m.width < 1 || m.height < 1 || m.width > kMaxDepthSide || m.height > kMaxDepthSide) {
-    last_error_ = "\"" + uri + "\" reports a depth size of " + std::to_string(m.width) + "x" + std::to_string(m.height);
-    return HalStatus::unsupported;
-  }
-
-  float hfov = 0, vfov = 0;
-  const bool has_h = m.stream.getProperty(ONI_STREAM_PROPERTY_HORIZONTAL_FOV, &hfov) == openni::STATUS_OK;
-  const bool has_v = m.stream.getProperty(ONI_STREAM_PROPERTY_VERTICAL_FOV, &vfov) == openni::STATUS_OK;
-  m.stats.hfov_rad = has_h ? static_cast<double>(hfov) : std::numeric_limits<double>::quiet_NaN();
-  m.stats.vfov_rad = has_v ? static_cast<double>(vfov) : std::numeric_limits<double>::quiet_NaN();
-  DepthIntrinsics from_fov;
-  if (has_h && has_v &&
-      intrinsics_from_fov(m.stats.hfov_rad, m.stats.vfov_rad, m.width, m.height, from_fov) == IntrinsicsCheck::ok) {
-    m.intrinsics = from_fov;
-    m.stats.intrinsics_source = IntrinsicsSource::device_fov;
-  } else if (has_fallback) {
-    if (fallback.width != m.width || fallback.height != m.height) {
-      return invalid("fallback_intrinsics are for " + std::to_string(fallback.width) + "x" +
-                     std::to_string(fallback.height) + ", the stream is " + std::to_string(m.width) + "x" +
-                     std::to_string(m.height));
-    }
-    m.intrinsics = fallback;
-    m.stats.intrinsics_source = IntrinsicsSource::configured;
-  } else {
-    m.intrinsics = DepthIntrinsics{};
-    m.intrinsics.width = m.width;
-    m.intrinsics.height = m.height;
-    m.stats.intrinsics_source = IntrinsicsSource::none;
-  }
+  // Each step runs only when every one before it succeeded.
+  if (!m.recording) status = resolve_device_uri(c.location, uri, last_error_);
+  if (status == HalStatus::ok) status = m.open_device(uri, last_error_);
+  if (status == HalStatus::ok && m.recording) status = m.set_playback(c.playback_speed, uri, last_error_);
+  if (status == HalStatus::ok) status = m.create_depth_stream(uri, last_error_);
+  const bool mode_requested = c.width != 0 || c.height != 0 || c.fps != 0;
+  if (status == HalStatus::ok && !m.recording && mode_requested) status = m.select_depth_mode(c, uri, last_error_);
+  if (status == HalStatus::ok) status = m.adopt_depth_mode(uri, last_error_);
+  if (status == HalStatus::ok) status = m.choose_intrinsics(c.fallback_intrinsics, last_error_);
+  if (status != HalStatus::ok) return status;
 
   if (m.recording) {
     // At least three of the file's largest frame intervals (at the playback speed).

@@ -4,12 +4,11 @@
 #include <cmath>
 #include <cstring>
 
+#include "sample_faults.hpp"
+
 namespace pliant::hal {
-namespace {
 
-void count(FaultCounters& counters, FaultKind kind) noexcept { ++counters.injected[static_cast<int>(kind)]; }
-
-}  // namespace
+using detail::SampleFate;
 
 template <class Camera, class Frame, class Element, std::uint32_t Supported>
 HalStatus FaultyCamera<Camera, Frame, Element, Supported>::set_fault_schedule(const FaultSchedule& schedule) noexcept {
@@ -38,10 +37,8 @@ HalStatus FaultyCamera<Camera, Frame, Element, Supported>::on_read(Frame& out) n
   const HalStatus status = inner_.read(frame);
   if (status != HalStatus::ok) return status;
   const ActiveFaults f = schedule_.active_at(frame.header.stamp_s);
-  if (f.has(FaultKind::drop)) {
-    count(injected_, FaultKind::drop);
-    return HalStatus::no_data;  // its sequence number becomes a gap
-  }
+  detail::FaultCounterSink counter{injected_};
+  if (detail::take_fault(f, FaultKind::drop, counter)) return HalStatus::no_data;  // its sequence number: a gap
   const std::size_t bytes = static_cast<std::size_t>(frame.height > 0 ? frame.height : 0) *
                             static_cast<std::size_t>(frame.stride_bytes > 0 ? frame.stride_bytes : 0);
   const std::size_t elements = bytes / sizeof(Element);
@@ -50,32 +47,23 @@ HalStatus FaultyCamera<Camera, Frame, Element, Supported>::on_read(Frame& out) n
   if (!fits && pixel_fault) ++oversized_;
 
   Frame result = frame;
-  bool from_previous = false;
-  if (fits && f.has(FaultKind::freeze_stamp) && has_last_) {
-    count(injected_, FaultKind::freeze_stamp);
+  // Only a frame that fits the buffers can be repeated or blanked. drop was taken above.
+  const SampleFate fate = detail::sample_fate(f, fits && has_last_, counter);
+  const bool from_previous = fate != SampleFate::fresh;
+  if (fate == SampleFate::repeat_previous) {
     result = last_;
     result.header.sequence = frame.header.sequence;
-    from_previous = true;
-  } else if (fits && f.has(FaultKind::freeze_data) && has_last_) {
-    count(injected_, FaultKind::freeze_data);
+  } else if (fate == SampleFate::previous_values) {
     result = last_;
     result.header = frame.header;
-    from_previous = true;
-  } else if (fits && f.has(FaultKind::nan)) {
-    count(injected_, FaultKind::nan);
+  } else if (fits && detail::take_fault(f, FaultKind::nan, counter)) {
     std::memset(delivered_.data(), 0, elements * sizeof(Element));
     result.data = delivered_.data();
   }
-  if (f.has(FaultKind::stamp_jump)) {
-    count(injected_, FaultKind::stamp_jump);
-    const double v = f.value[static_cast<int>(FaultKind::stamp_jump)];
-    result.header.stamp_s += std::isnan(v) ? 0.5 : v;
-  }
-  if (f.has(FaultKind::fault_bits)) {
-    count(injected_, FaultKind::fault_bits);
-    const double v = f.value[static_cast<int>(FaultKind::fault_bits)];
-    result.header.status_bits |= std::isnan(v) ? kFrameDeviceFault : static_cast<std::uint32_t>(v);
-  }
+  // Header faults apply to every delivered frame, a repeated one included (the mocks' own
+  // freeze_stamp repeats the header as it was).
+  detail::apply_stamp_and_status_faults(f, kFrameDeviceFault, counter, result.header.stamp_s,
+                                        result.header.status_bits);
   // Keep what was delivered for the freeze kinds (only when the schedule has them).
   const bool freezes =
       (schedule_.kinds() & (fault_bit(FaultKind::freeze_data) | fault_bit(FaultKind::freeze_stamp))) != 0;

@@ -3,45 +3,30 @@
 #include <algorithm>
 #include <cmath>
 
+#include "sample_faults.hpp"
+
 namespace pliant::hal {
 namespace {
 
+using detail::SampleFate;
+
 constexpr double kPi = 3.14159265358979323846;
 
-// The header of a frame after the sample faults that only touch the header. Returns false for
-// a dropped frame; `fresh` tells the caller to render new pixels.
-bool frame_header(MockStream& stream, const ActiveFaults& f, double stamp, std::uint64_t sequence, bool has_last,
-                  const SampleHeader& last, std::uint32_t default_bits, SampleHeader& header, bool& fresh) noexcept {
-  if (f.has(FaultKind::drop)) {
-    stream.count(FaultKind::drop);
-    return false;
-  }
-  fresh = true;
-  if (f.has(FaultKind::freeze_stamp) && has_last) {
-    stream.count(FaultKind::freeze_stamp);
+// A frame's fate under its sample faults and its header (unset when dropped); the caller renders
+// new pixels for a fresh frame and keeps the previous ones otherwise.
+SampleFate frame_header(MockStream& stream, const ActiveFaults& f, double stamp, std::uint64_t sequence, bool has_last,
+                        const SampleHeader& last, std::uint32_t default_bits, SampleHeader& header) noexcept {
+  const SampleFate fate = detail::sample_fate(f, has_last, stream);
+  if (fate == SampleFate::dropped) return fate;
+  if (fate == SampleFate::repeat_previous) {
     header = last;
-    fresh = false;
   } else {
-    header.status_bits = 0;
-    if (f.has(FaultKind::freeze_data) && has_last) {
-      stream.count(FaultKind::freeze_data);
-      header.status_bits = last.status_bits;
-      fresh = false;
-    }
+    header.status_bits = fate == SampleFate::previous_values ? last.status_bits : 0u;
     header.stamp_s = stamp;
-    if (f.has(FaultKind::stamp_jump)) {
-      stream.count(FaultKind::stamp_jump);
-      const double jump = f.value[static_cast<int>(FaultKind::stamp_jump)];
-      header.stamp_s += std::isnan(jump) ? 0.5 : jump;
-    }
-    if (f.has(FaultKind::fault_bits)) {
-      stream.count(FaultKind::fault_bits);
-      const double v = f.value[static_cast<int>(FaultKind::fault_bits)];
-      header.status_bits |= std::isnan(v) ? default_bits : static_cast<std::uint32_t>(v);
-    }
+    detail::apply_stamp_and_status_faults(f, default_bits, stream, header.stamp_s, header.status_bits);
   }
   header.sequence = sequence;
-  return true;
+  return fate;
 }
 
 bool valid_size(int width, int height) { return width >= 1 && width <= 4096 && height >= 1 && height <= 4096; }
@@ -79,12 +64,10 @@ HalStatus MockColorCamera::on_read(ColorFrame& out) noexcept {
   double stamp = 0;
   if (!stream_.take(now, index, stamp, sequence)) return HalStatus::no_data;
   SampleHeader header;
-  bool fresh = true;
-  if (!frame_header(stream_, stream_.sample_faults(stamp), stamp, sequence, has_last_, last_header_, config_.fault_bits,
-                    header, fresh)) {
-    return HalStatus::no_data;
-  }
-  if (fresh) {
+  const SampleFate fate = frame_header(stream_, stream_.sample_faults(stamp), stamp, sequence, has_last_, last_header_,
+                                       config_.fault_bits, header);
+  if (fate == SampleFate::dropped) return HalStatus::no_data;
+  if (fate == SampleFate::fresh) {
     const int channels = pixel_bytes(config_.format);
     const auto levels = static_cast<std::uint64_t>(config_.noise_levels);
     for (int y = 0; y < config_.height; ++y) {
@@ -141,12 +124,11 @@ HalStatus MockDepthCamera::on_read(DepthFrame& out) noexcept {
   if (!stream_.take(now, index, stamp, sequence)) return HalStatus::no_data;
   const ActiveFaults f = stream_.sample_faults(stamp);
   SampleHeader header;
-  bool fresh = true;
-  if (!frame_header(stream_, f, stamp, sequence, has_last_, last_header_, config_.fault_bits, header, fresh)) {
-    return HalStatus::no_data;
-  }
+  const SampleFate fate =
+      frame_header(stream_, f, stamp, sequence, has_last_, last_header_, config_.fault_bits, header);
+  if (fate == SampleFate::dropped) return HalStatus::no_data;
   const MockDepthCameraConfig& c = config_;
-  if (fresh) {
+  if (fate == SampleFate::fresh) {
     const double sigma = c.width / 8.0;
     const double centre_x = static_cast<double>(index % static_cast<std::uint64_t>(c.width));
     const double centre_y = 0.5 * c.height;
@@ -161,10 +143,7 @@ HalStatus MockDepthCamera::on_read(DepthFrame& out) noexcept {
             static_cast<std::uint16_t>(mm);
       }
     }
-    if (f.has(FaultKind::nan)) {
-      stream_.count(FaultKind::nan);
-      std::fill(image_.begin(), image_.end(), std::uint16_t{0});
-    }
+    if (detail::take_fault(f, FaultKind::nan, stream_)) std::fill(image_.begin(), image_.end(), std::uint16_t{0});
   }
   last_header_ = header;
   has_last_ = true;

@@ -6,7 +6,11 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "sample_faults.hpp"
+
 namespace pliant::hal {
+
+using detail::SampleFate;
 
 HalStatus MockForceTorqueSensor::on_configure() {
   const MockForceTorqueConfig& c = config_;
@@ -44,45 +48,28 @@ HalStatus MockForceTorqueSensor::on_read(WrenchReading& out) noexcept {
   double stamp = 0;
   if (!stream_.take(now, index, stamp, sequence)) return HalStatus::no_data;
   const ActiveFaults f = stream_.sample_faults(stamp);
-  if (f.has(FaultKind::drop)) {
-    stream_.count(FaultKind::drop);
-    return HalStatus::no_data;
-  }
+  const SampleFate fate = detail::sample_fate(f, has_last_, stream_);
+  if (fate == SampleFate::dropped) return HalStatus::no_data;
   WrenchReading r;
-  if (f.has(FaultKind::freeze_stamp) && has_last_) {
-    stream_.count(FaultKind::freeze_stamp);
-    r = last_;
-  } else {
-    if (f.has(FaultKind::freeze_data) && has_last_) {
-      stream_.count(FaultKind::freeze_data);
-      r = last_;
-    } else {
-      const Eigen::Matrix3d rot = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(config_.rotation);
-      const Eigen::Vector3d contact(plant_.grip_force_n(), 0, 0);
-      const Eigen::Vector3d force = rot.transpose() * (contact + Eigen::Map<const Eigen::Vector3d>(config_.load_n));
-      const Eigen::Vector3d torque =
-          rot.transpose() * Eigen::Map<const Eigen::Vector3d>(config_.lever_m).cross(contact);
-      for (int d = 0; d < 3; ++d) {
-        r.wrench[d] = force(d) + config_.force_noise_n * normal_(rng_);
-        r.wrench[3 + d] = torque(d) + config_.torque_noise_nm * normal_(rng_);
-      }
-      r.header.status_bits = 0;
+  if (fate == SampleFate::fresh) {
+    const Eigen::Matrix3d rot = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(config_.rotation);
+    const Eigen::Vector3d contact(plant_.grip_force_n(), 0, 0);
+    const Eigen::Vector3d force = rot.transpose() * (contact + Eigen::Map<const Eigen::Vector3d>(config_.load_n));
+    const Eigen::Vector3d torque = rot.transpose() * Eigen::Map<const Eigen::Vector3d>(config_.lever_m).cross(contact);
+    for (int d = 0; d < 3; ++d) {
+      r.wrench[d] = force(d) + config_.force_noise_n * normal_(rng_);
+      r.wrench[3 + d] = torque(d) + config_.torque_noise_nm * normal_(rng_);
     }
+    r.header.status_bits = 0;
+  } else {
+    r = last_;  // freeze_stamp: the whole previous reading; freeze_data: its values and status
+  }
+  if (fate != SampleFate::repeat_previous) {
     r.header.stamp_s = stamp;
-    if (f.has(FaultKind::nan)) {
-      stream_.count(FaultKind::nan);
+    if (detail::take_fault(f, FaultKind::nan, stream_)) {
       for (double& v : r.wrench) v = std::numeric_limits<double>::quiet_NaN();
     }
-    if (f.has(FaultKind::stamp_jump)) {
-      stream_.count(FaultKind::stamp_jump);
-      const double jump = f.value[static_cast<int>(FaultKind::stamp_jump)];
-      r.header.stamp_s += std::isnan(jump) ? 0.5 : jump;
-    }
-    if (f.has(FaultKind::fault_bits)) {
-      stream_.count(FaultKind::fault_bits);
-      const double v = f.value[static_cast<int>(FaultKind::fault_bits)];
-      r.header.status_bits |= std::isnan(v) ? config_.fault_bits : static_cast<std::uint32_t>(v);
-    }
+    detail::apply_stamp_and_status_faults(f, config_.fault_bits, stream_, r.header.stamp_s, r.header.status_bits);
   }
   r.header.sequence = sequence;
   last_ = r;

@@ -3,7 +3,12 @@
 #include <cmath>
 #include <limits>
 
+#include "sample_faults.hpp"
+
 namespace pliant::hal {
+
+using detail::SampleFate;
+
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -63,47 +68,29 @@ HalStatus MockGripper::on_read(GripperReading& out) noexcept {
   double stamp = 0;
   if (!stream_.take(now, index, stamp, sequence)) return HalStatus::no_data;
   const ActiveFaults f = stream_.sample_faults(stamp);
-  if (f.has(FaultKind::drop)) {
-    stream_.count(FaultKind::drop);
-    return HalStatus::no_data;
-  }
+  const SampleFate fate = detail::sample_fate(f, has_last_, stream_);
+  if (fate == SampleFate::dropped) return HalStatus::no_data;
   GripperReading r;
-  if (f.has(FaultKind::freeze_stamp) && has_last_) {
-    stream_.count(FaultKind::freeze_stamp);
-    r = last_;
+  if (fate == SampleFate::fresh) {
+    const double force = plant_.grip_force_n();
+    r.width_m = plant_.width_m() + config_.width_noise_m * normal_(rng_);
+    r.force_n = force + config_.force_noise_n * normal_(rng_);
+    r.current_a =
+        config_.current_offset_a + force / config_.current_gain_n_per_a + config_.current_noise_a * normal_(rng_);
+    r.target_width_m = plant_.target_width_m();
+    std::uint32_t bits = kGripperActivated;
+    if (plant_.moving()) bits |= kGripperMoving;
+    if (plant_.object_detected()) bits |= kGripperObjectDetected;
+    if (!plant_.moving() && plant_.width_m() == plant_.target_width_m()) bits |= kGripperAtTarget;
+    r.header.status_bits = bits;
   } else {
-    if (f.has(FaultKind::freeze_data) && has_last_) {
-      stream_.count(FaultKind::freeze_data);
-      r = last_;
-    } else {
-      const double force = plant_.grip_force_n();
-      r.width_m = plant_.width_m() + config_.width_noise_m * normal_(rng_);
-      r.force_n = force + config_.force_noise_n * normal_(rng_);
-      r.current_a =
-          config_.current_offset_a + force / config_.current_gain_n_per_a + config_.current_noise_a * normal_(rng_);
-      r.target_width_m = plant_.target_width_m();
-      std::uint32_t bits = kGripperActivated;
-      if (plant_.moving()) bits |= kGripperMoving;
-      if (plant_.object_detected()) bits |= kGripperObjectDetected;
-      if (!plant_.moving() && plant_.width_m() == plant_.target_width_m()) bits |= kGripperAtTarget;
-      r.header.status_bits = bits;
-    }
+    r = last_;  // freeze_stamp: the whole previous reading; freeze_data: its values and status
+  }
+  if (fate != SampleFate::repeat_previous) {
     r.header.stamp_s = stamp;
-    if (f.has(FaultKind::nan)) {
-      stream_.count(FaultKind::nan);
-      r.width_m = r.force_n = r.current_a = kNaN;
-    }
-    if (f.has(FaultKind::stamp_jump)) {
-      stream_.count(FaultKind::stamp_jump);
-      const double jump = f.value[static_cast<int>(FaultKind::stamp_jump)];
-      r.header.stamp_s += std::isnan(jump) ? 0.5 : jump;
-    }
-    if (f.has(FaultKind::fault_bits)) {
-      stream_.count(FaultKind::fault_bits);
-      const double v = f.value[static_cast<int>(FaultKind::fault_bits)];
-      r.header.status_bits |=
-          std::isnan(v) ? (std::uint32_t{config_.fault_code} << kGripperFaultCodeShift) : static_cast<std::uint32_t>(v);
-    }
+    if (detail::take_fault(f, FaultKind::nan, stream_)) r.width_m = r.force_n = r.current_a = kNaN;
+    const std::uint32_t fault_word = std::uint32_t{config_.fault_code} << kGripperFaultCodeShift;
+    detail::apply_stamp_and_status_faults(f, fault_word, stream_, r.header.stamp_s, r.header.status_bits);
   }
   r.header.sequence = sequence;
   last_ = r;

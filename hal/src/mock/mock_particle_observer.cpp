@@ -4,7 +4,11 @@
 #include <cmath>
 #include <limits>
 
+#include "sample_faults.hpp"
+
 namespace pliant::hal {
+
+using detail::SampleFate;
 
 HalStatus MockParticleObserver::on_configure() {
   const MockParticleObserverConfig& c = config_;
@@ -68,27 +72,22 @@ HalStatus MockParticleObserver::on_read(ParticleFrame& out) noexcept {
   const auto slot = static_cast<std::size_t>(index % static_cast<std::uint64_t>(slots_));
   if (slot_index_[slot] != static_cast<std::int64_t>(index)) return HalStatus::no_data;  // capture missed: lost
   const ActiveFaults f = stream_.sample_faults(stamp);
-  if (f.has(FaultKind::drop)) {
-    stream_.count(FaultKind::drop);
-    return HalStatus::no_data;
-  }
+  const SampleFate fate = detail::sample_fate(f, has_last_, stream_);
+  if (fate == SampleFate::dropped) return HalStatus::no_data;
   SampleHeader header;
   int observed = n_;
-  if (f.has(FaultKind::freeze_stamp) && has_last_) {
-    stream_.count(FaultKind::freeze_stamp);
+  if (fate == SampleFate::repeat_previous) {
     header = last_header_;
     observed = last_observed_;
   } else {
-    if (f.has(FaultKind::freeze_data) && has_last_) {
-      stream_.count(FaultKind::freeze_data);
+    if (fate == SampleFate::previous_values) {
       header.status_bits = last_header_.status_bits;
       observed = last_observed_;
     } else {
       const double* src = captured_.data() + slot * static_cast<std::size_t>(n_) * 3;
       for (std::size_t k = 0; k < frame_.size(); ++k) frame_[k] = src[k] + config_.noise_m * normal_(rng_);
       double hidden = config_.occlusion_fraction;
-      if (f.has(FaultKind::occlude)) {
-        stream_.count(FaultKind::occlude);
+      if (detail::take_fault(f, FaultKind::occlude, stream_)) {
         const double v = f.value[static_cast<int>(FaultKind::occlude)];
         hidden = std::max(hidden, std::isnan(v) ? 0.5 : v);
       }
@@ -101,21 +100,11 @@ HalStatus MockParticleObserver::on_read(ParticleFrame& out) noexcept {
       header.status_bits = count > 0 ? kFramePartial : 0u;
     }
     header.stamp_s = stamp;
-    if (f.has(FaultKind::nan)) {
-      stream_.count(FaultKind::nan);
+    if (detail::take_fault(f, FaultKind::nan, stream_)) {
       for (double& v : frame_) v = std::numeric_limits<double>::quiet_NaN();
       observed = 0;
     }
-    if (f.has(FaultKind::stamp_jump)) {
-      stream_.count(FaultKind::stamp_jump);
-      const double jump = f.value[static_cast<int>(FaultKind::stamp_jump)];
-      header.stamp_s += std::isnan(jump) ? 0.5 : jump;
-    }
-    if (f.has(FaultKind::fault_bits)) {
-      stream_.count(FaultKind::fault_bits);
-      const double v = f.value[static_cast<int>(FaultKind::fault_bits)];
-      header.status_bits |= std::isnan(v) ? config_.fault_bits : static_cast<std::uint32_t>(v);
-    }
+    detail::apply_stamp_and_status_faults(f, config_.fault_bits, stream_, header.stamp_s, header.status_bits);
   }
   header.sequence = sequence;
   last_header_ = header;

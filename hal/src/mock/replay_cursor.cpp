@@ -4,7 +4,11 @@
 #include <cmath>
 #include <limits>
 
+#include "sample_faults.hpp"
+
 namespace pliant::hal {
+
+using detail::SampleFate;
 
 HalStatus ReplayCursor::configure(const RecordedChannel& channel, const ReplayTiming& timing, std::uint32_t supported,
                                   std::uint32_t default_fault_bits) {
@@ -85,40 +89,25 @@ bool ReplayCursor::take(double now_s, ReplaySample& out) noexcept {
   next_ = index + 1;
   const double stamp = stamp_of(index);
   const ActiveFaults f = schedule_.active_at(stamp);
-  if (f.has(FaultKind::drop)) {
-    count(FaultKind::drop);
-    return false;
-  }
+  const SampleFate fate = detail::sample_fate(f, has_last_, *this);
+  if (fate == SampleFate::dropped) return false;
   ReplaySample s;
   s.index = index;
   s.sequence = static_cast<std::uint64_t>(index) + 1;
   s.faults = f;
-  if (f.has(FaultKind::freeze_stamp) && has_last_) {
-    count(FaultKind::freeze_stamp);
+  if (fate == SampleFate::repeat_previous) {
     s.stamp_s = last_stamp_s_;
     s.status_bits = last_status_;
   } else {
-    if (f.has(FaultKind::freeze_data) && has_last_) {
-      count(FaultKind::freeze_data);  // row_ keeps the previous values
-    } else {
+    if (fate == SampleFate::fresh) {  // previous_values: row_ keeps the previous values
       const double* src = channel_->values.data() + static_cast<std::size_t>(index) * row_.size();
       std::copy(src, src + row_.size(), row_.begin());
     }
     s.stamp_s = stamp;
-    if (f.has(FaultKind::nan)) {
-      count(FaultKind::nan);
+    if (detail::take_fault(f, FaultKind::nan, *this)) {
       std::fill(row_.begin(), row_.end(), std::numeric_limits<double>::quiet_NaN());
     }
-    if (f.has(FaultKind::stamp_jump)) {
-      count(FaultKind::stamp_jump);
-      const double jump = f.value[static_cast<int>(FaultKind::stamp_jump)];
-      s.stamp_s += std::isnan(jump) ? 0.5 : jump;
-    }
-    if (f.has(FaultKind::fault_bits)) {
-      count(FaultKind::fault_bits);
-      const double v = f.value[static_cast<int>(FaultKind::fault_bits)];
-      s.status_bits |= std::isnan(v) ? default_fault_bits_ : static_cast<std::uint32_t>(v);
-    }
+    detail::apply_stamp_and_status_faults(f, default_fault_bits_, *this, s.stamp_s, s.status_bits);
   }
   s.values = row_.data();
   last_index_ = index;

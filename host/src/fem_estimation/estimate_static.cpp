@@ -887,10 +887,10 @@ YoungsModulusEstimate estimate_youngs_modulus_from_reaction(const FemRecordingPr
 // ---------------------------------------------------------------------------------------------
 // (f) remote force estimation
 
-ContactForceEstimate estimate_contact_force(const FemRecordingProblem& problem, double youngs_modulus_pa,
-                                            const ContactForceOptions& options) {
-  const Timer timer;
-  const std::string label = "estimate_contact_force(" + problem.name + "): ";
+namespace {
+
+void check_contact_inputs(const FemRecordingProblem& problem, double youngs_modulus_pa,
+                          const ContactForceOptions& options, const std::string& label) {
   if (!(youngs_modulus_pa > 0) || !std::isfinite(youngs_modulus_pa)) {
     throw std::invalid_argument(label + "youngs_modulus_pa must be positive");
   }
@@ -898,164 +898,268 @@ ContactForceEstimate estimate_contact_force(const FemRecordingProblem& problem, 
   if (options.force_bound_n < 0 || options.probe_travel_bound_m < 0 || options.position_noise_m < 0) {
     throw std::invalid_argument(label + "force_bound_n, probe_travel_bound_m and position_noise_m must be >= 0");
   }
-  const bool rigid = options.contact == ContactModel::rigid_probe;
-  const double diagonal = bounding_box_diagonal(problem.mesh);
+}
+
+// Rigid probe: adds the applied_to nodes that are neither fixed nor driven to the plan's driven set
+// (kept ascending), at rest, and reads the tool force there. Returns their slots in the new set.
+std::vector<int> attach_probe(const FemRecordingProblem& problem, FramePlan& plan, const std::string& label) {
+  std::vector<int> driven = plan.driven;
+  for (int node : problem.applied_to) {
+    if (!contains(problem.fixed_nodes, node) && !contains(plan.driven, node)) driven.push_back(node);
+  }
+  std::sort(driven.begin(), driven.end());
+  Eigen::VectorXd base(3 * ix(driven.size()));
+  std::vector<int> slots;
+  for (std::size_t k = 0; k < driven.size(); ++k) {
+    const auto it = std::lower_bound(plan.driven.begin(), plan.driven.end(), driven[k]);
+    if (it != plan.driven.end() && *it == driven[k]) {
+      base.segment<3>(3 * ix(k)) = plan.driven_position.segment<3>(3 * (it - plan.driven.begin()));
+    } else {
+      base.segment<3>(3 * ix(k)) =
+          Eigen::Vector3d(problem.mesh.points[uz(3 * driven[k])], problem.mesh.points[uz(3 * driven[k] + 1)],
+                          problem.mesh.points[uz(3 * driven[k] + 2)]);
+      slots.push_back(static_cast<int>(k));
+    }
+  }
+  if (slots.empty()) throw std::invalid_argument(label + "every applied_to node is fixed or driven: no probe to move");
+  plan.driven = std::move(driven);
+  plan.driven_position = std::move(base);
+  plan.reaction_nodes = problem.applied_to;
+  return slots;
+}
+
+// The plans of the selected frames and, for the rigid probe, where the probe sits in each plan's
+// driven set (probe_slots[p], one entry per plan; empty for spread_force).
+struct ContactPlans {
   std::vector<FramePlan> plans;
-  std::vector<std::vector<int>> probe_slots;  // rigid probe: where applied_to sits in plan.driven
-  for (int f : select_frames(problem, options.frames, false)) {
+  std::vector<std::vector<int>> probe_slots;
+};
+
+ContactPlans plan_contact_frames(const FemRecordingProblem& problem, const FrameSelection& selection, bool rigid,
+                                 const std::string& label) {
+  ContactPlans out;
+  for (int f : select_frames(problem, selection, false)) {
     FramePlan plan = make_plan(problem, f);  // tracked: before the probe joins the driven set
-    if (rigid) {
-      std::vector<int> driven = plan.driven;
-      for (int node : problem.applied_to) {
-        if (!contains(problem.fixed_nodes, node) && !contains(plan.driven, node)) driven.push_back(node);
-      }
-      std::sort(driven.begin(), driven.end());
-      Eigen::VectorXd base(3 * ix(driven.size()));
-      std::vector<int> slots;
-      for (std::size_t k = 0; k < driven.size(); ++k) {
-        const auto it = std::lower_bound(plan.driven.begin(), plan.driven.end(), driven[k]);
-        if (it != plan.driven.end() && *it == driven[k]) {
-          base.segment<3>(3 * ix(k)) = plan.driven_position.segment<3>(3 * (it - plan.driven.begin()));
-        } else {
-          base.segment<3>(3 * ix(k)) =
-              Eigen::Vector3d(problem.mesh.points[uz(3 * driven[k])], problem.mesh.points[uz(3 * driven[k] + 1)],
-                              problem.mesh.points[uz(3 * driven[k] + 2)]);
-          slots.push_back(static_cast<int>(k));
+    if (rigid) out.probe_slots.push_back(attach_probe(problem, plan, label));
+    out.plans.push_back(std::move(plan));
+  }
+  if (out.plans.empty()) throw std::invalid_argument(label + "no frame selected");
+  if (position_residual_count(out.plans) == 0) {
+    throw std::invalid_argument(label + "no tracked free node in the selected frames");
+  }
+  return out;
+}
+
+// The per-frame fit of estimate_contact_force. Its unknown u (3 values) is the contact force (N,
+// spread over applied_to by contact_shares) or the rigid probe's translation from rest (m); each
+// frame's u minimises the whitened misfit of the tracked positions. Threads share the pool (one
+// workspace each) and fit disjoint rows.
+class ContactFrameFitter {
+ public:
+  ContactFrameFitter(const FemRecordingProblem& problem, FramePool& pool, const ContactForceOptions& options,
+                     double youngs_modulus_pa, std::vector<std::vector<int>> probe_slots)
+      : problem_(problem),
+        pool_(pool),
+        options_(options),
+        youngs_modulus_pa_(youngs_modulus_pa),
+        rigid_(options.contact == ContactModel::rigid_probe),
+        probe_slots_(std::move(probe_slots)),
+        shares_(contact_shares(problem.mesh, problem.applied_to, options.load_spread)),
+        noise_m_(options.position_noise_m > 0 ? options.position_noise_m : 1e-3),
+        node_count_(pool.model(0).node_count()) {
+    const double diagonal = bounding_box_diagonal(problem.mesh);
+    bound_ = rigid_ ? (options.probe_travel_bound_m > 0 ? options.probe_travel_bound_m : diagonal)
+                    : (options.force_bound_n > 0 ? options.force_bound_n : youngs_modulus_pa * diagonal * diagonal);
+  }
+
+  // Fits thread t's block of plans in time order, each frame started from the previous one's u
+  // (zero for the first); fills their rows. Returns the evaluations spent.
+  int fit_block(int t, std::vector<ContactForceFrame>& rows) {
+    const auto [begin, end] = pool_.block(t);
+    Scratch scratch;
+    scratch.load.resize(3 * ix(node_count_));
+    Eigen::Vector3d start = Eigen::Vector3d::Zero();
+    long previous = -1;
+    int evaluations = 0;
+    for (std::size_t p = begin; p < end; ++p) {
+      const FramePlan& plan = pool_.plans()[p];
+      const FemFrame& frame = problem_.frames[uz(plan.frame)];
+      ContactForceFrame& row = rows[p];
+      row.frame = plan.frame;
+      row.time_s = frame.time_s;
+      row.has_measurement = frame.has_wrench;
+      row.measured_force_n = frame.wrench_force_n;
+      row.position_count = static_cast<int>(plan.tracked.size());
+      if (plan.tracked.empty()) continue;  // nothing to fit in this frame
+      evaluations += fit_frame(t, p, previous, start, scratch, row);
+      previous = static_cast<long>(p);
+    }
+    return evaluations;
+  }
+
+ private:
+  // Per-thread buffers of the solves: the 3n load (spread_force), the driven positions (rigid).
+  struct Scratch {
+    Eigen::VectorXd load;
+    Eigen::VectorXd driven;
+  };
+
+  // One static solve of plan p at u (FramePool::solve: memo, warm start from plan `warm`).
+  bool simulate(int t, std::size_t p, const Eigen::VectorXd& u, long warm, Scratch& scratch) {
+    if (rigid_) {
+      scratch.driven = pool_.plans()[p].driven_position;
+      for (int slot : probe_slots_[p]) scratch.driven.segment<3>(3 * ix(slot)) += u;
+      return pool_.solve(t, p, youngs_modulus_pa_, Eigen::VectorXd(), u, false, warm, &scratch.driven);
+    }
+    scratch.load.setZero();
+    add_contact_load(Eigen::Vector3d(u), Eigen::Vector3d::Zero(), problem_.applied_to, shares_, pool_.rest(),
+                     scratch.load);
+    return pool_.solve(t, p, youngs_modulus_pa_, scratch.load, u, false, warm);
+  }
+
+  // The three unknowns, each within +-bound, started at `start` (kept inside the bounds).
+  std::vector<FitParameter> parameters(const Eigen::Vector3d& start) const {
+    std::vector<FitParameter> parameters;
+    const char* names[2][3] = {{"force_x", "force_y", "force_z"}, {"probe_dx", "probe_dy", "probe_dz"}};
+    for (int a = 0; a < 3; ++a) {
+      FitParameter q;
+      q.name = names[rigid_ ? 1 : 0][a];
+      q.lower = -bound_;
+      q.upper = bound_;
+      q.initial = std::clamp(start(a), -0.999 * bound_, 0.999 * bound_);
+      q.log_scale = false;
+      parameters.push_back(q);
+    }
+    return parameters;
+  }
+
+  // Covariance of the force (N^2) from the fit's covariance of u: the same for spread_force; for
+  // the rigid probe J C J^T with J = dF/du by central differences (warm-started solves, counted in
+  // `extra`). NaN when the fit gave none.
+  Eigen::Matrix3d force_covariance(int t, std::size_t p, long warm, const Eigen::Vector3d& u, const FitResult& fit,
+                                   Scratch& scratch, int& extra) {
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Constant(kNaN);
+    if (fit.covariance.rows() == 3) covariance = fit.covariance;
+    if (!rigid_ || !covariance.allFinite()) return covariance;
+    const double h = std::max(options_.fit.difference_step, 1e-9) * 2 * bound_;
+    Eigen::Matrix3d jacobian;
+    for (int a = 0; a < 3; ++a) {
+      Eigen::Vector3d du = Eigen::Vector3d::Zero();
+      du(a) = h;
+      const bool plus_ok = simulate(t, p, Eigen::VectorXd(u + du), warm, scratch);
+      const Eigen::Vector3d plus = pool_.cache()[p].tool_force;
+      const bool minus_ok = simulate(t, p, Eigen::VectorXd(u - du), warm, scratch);
+      const Eigen::Vector3d minus = pool_.cache()[p].tool_force;
+      extra += 2;
+      jacobian.col(a) =
+          plus_ok && minus_ok ? Eigen::Vector3d((plus - minus) / (2 * h)) : Eigen::Vector3d::Constant(kNaN);
+    }
+    // In place: Eigen evaluates the aliased product through a temporary, and a returned product
+    // rounds differently in the last bit (results are compared bit for bit across changes).
+    covariance = jacobian * covariance * jacobian.transpose();
+    return covariance;
+  }
+
+  // Fits plan p (warm-started from plan `warm`, -1 for none) from `start`, fills the row's
+  // estimate, leaves the plan's cache at the solution and `start` at its u. Returns the evaluations.
+  int fit_frame(int t, std::size_t p, long warm, Eigen::Vector3d& start, Scratch& scratch, ContactForceFrame& row) {
+    const FramePlan& plan = pool_.plans()[p];
+    const FemFrame& frame = problem_.frames[uz(plan.frame)];
+    const ResidualFunction residuals = [&](const std::vector<double>& values, std::vector<double>& r) {
+      if (!simulate(t, p, Eigen::Vector3d(values[0], values[1], values[2]).eval(), warm, scratch)) return false;
+      const Eigen::VectorXd& x = pool_.cache()[p].position;
+      std::size_t k = 0;
+      for (int node : plan.tracked) {
+        for (int a = 0; a < 3; ++a) {
+          const Eigen::Index i = 3 * ix(node) + a;
+          r[k++] = (x(i) - frame.observed_position_m(i)) / noise_m_;
         }
       }
-      if (slots.empty())
-        throw std::invalid_argument(label + "every applied_to node is fixed or driven: no probe to move");
-      plan.driven = std::move(driven);
-      plan.driven_position = std::move(base);
-      plan.reaction_nodes = problem.applied_to;
-      probe_slots.push_back(std::move(slots));
-    }
-    plans.push_back(std::move(plan));
+      return true;
+    };
+    const FitResult fit = fit_least_squares(parameters(start), 3 * row.position_count, residuals, options_.fit);
+    const Eigen::Vector3d u(fit.values[0], fit.values[1], fit.values[2]);
+    int extra = 0;
+    const Eigen::Matrix3d covariance = force_covariance(t, p, warm, u, fit, scratch, extra);
+    const bool solved = simulate(t, p, Eigen::VectorXd(u), warm, scratch);  // leave the cache at the solution
+    row.estimated_force_n = rigid_ ? pool_.cache()[p].tool_force : u;
+    if (rigid_) row.probe_displacement_m = u;
+    for (int a = 0; a < 3; ++a) row.standard_deviation_n(a) = std::sqrt(covariance(a, a));
+    row.iterations = fit.iterations;
+    row.evaluations = fit.evaluations + extra + 1;
+    const bool at_bound = std::any_of(fit.at_bound.begin(), fit.at_bound.end(), [](bool b) { return b; });
+    row.converged = fit.converged && solved && !at_bound;
+    start = u;
+    return row.evaluations;
   }
-  if (plans.empty()) throw std::invalid_argument(label + "no frame selected");
-  if (position_residual_count(plans) == 0)
-    throw std::invalid_argument(label + "no tracked free node in the selected frames");
 
-  const double bound =
-      rigid ? (options.probe_travel_bound_m > 0 ? options.probe_travel_bound_m : diagonal)
-            : (options.force_bound_n > 0 ? options.force_bound_n : youngs_modulus_pa * diagonal * diagonal);
-  const double noise = options.position_noise_m > 0 ? options.position_noise_m : 1e-3;
-  FramePool pool(problem, std::move(plans), options.threads, options.static_options, youngs_modulus_pa);
-  const int n = pool.model(0).node_count();
-  const std::vector<double> shares = contact_shares(problem.mesh, problem.applied_to, options.load_spread);
+  const FemRecordingProblem& problem_;
+  FramePool& pool_;
+  const ContactForceOptions& options_;
+  double youngs_modulus_pa_;
+  bool rigid_;
+  std::vector<std::vector<int>> probe_slots_;
+  std::vector<double> shares_;  // of the force per applied_to node (spread_force)
+  double noise_m_;              // whitening of the position residuals
+  int node_count_;              // of the model
+  double bound_ = 0;            // on each component of u (N or m)
+};
 
-  ContactForceEstimate e;
-  e.youngs_modulus_pa = youngs_modulus_pa;
-  e.contact = options.contact;
-  e.frames.resize(pool.plans().size());
+// Runs fit_block on every thread of the pool; rethrows a thread's error with `label`. Returns
+// the evaluations of all threads.
+int fit_frames_on_threads(FramePool& pool, ContactFrameFitter& fitter, std::vector<ContactForceFrame>& rows,
+                          const std::string& label) {
   std::vector<int> evaluations(uz(pool.thread_count()), 0);
   std::vector<std::string> errors(uz(pool.thread_count()));
-
-  auto run = [&](int t) {
+  pool.for_each_thread([&](int t) {
     try {
-      const auto [begin, end] = pool.block(t);
-      Eigen::Vector3d start = Eigen::Vector3d::Zero();
-      long previous = -1;
-      Eigen::VectorXd load(3 * ix(n));
-      Eigen::VectorXd driven;
-      for (std::size_t p = begin; p < end; ++p) {
-        const FramePlan& plan = pool.plans()[p];
-        const FemFrame& frame = problem.frames[uz(plan.frame)];
-        ContactForceFrame& row = e.frames[p];
-        row.frame = plan.frame;
-        row.time_s = frame.time_s;
-        row.has_measurement = frame.has_wrench;
-        row.measured_force_n = frame.wrench_force_n;
-        row.position_count = static_cast<int>(plan.tracked.size());
-        if (plan.tracked.empty()) continue;  // nothing to fit in this frame
-        const long warm = previous;
-        // One static solve for the unknown u (a force, or the probe's translation).
-        auto simulate = [&](const Eigen::VectorXd& u) {
-          if (rigid) {
-            driven = plan.driven_position;
-            for (int slot : probe_slots[p]) driven.segment<3>(3 * ix(slot)) += u;
-            return pool.solve(t, p, youngs_modulus_pa, Eigen::VectorXd(), u, false, warm, &driven);
-          }
-          load.setZero();
-          add_contact_load(Eigen::Vector3d(u), Eigen::Vector3d::Zero(), problem.applied_to, shares, pool.rest(), load);
-          return pool.solve(t, p, youngs_modulus_pa, load, u, false, warm);
-        };
-        auto force_of = [&](const Eigen::Vector3d& u) -> Eigen::Vector3d {
-          return rigid ? pool.cache()[p].tool_force : u;
-        };
-        const ResidualFunction residuals = [&](const std::vector<double>& values, std::vector<double>& r) {
-          if (!simulate(Eigen::Vector3d(values[0], values[1], values[2]).eval())) return false;
-          const Eigen::VectorXd& x = pool.cache()[p].position;
-          std::size_t k = 0;
-          for (int node : plan.tracked) {
-            for (int a = 0; a < 3; ++a) {
-              const Eigen::Index i = 3 * ix(node) + a;
-              r[k++] = (x(i) - frame.observed_position_m(i)) / noise;
-            }
-          }
-          return true;
-        };
-        std::vector<FitParameter> parameters;
-        const char* names[2][3] = {{"force_x", "force_y", "force_z"}, {"probe_dx", "probe_dy", "probe_dz"}};
-        for (int a = 0; a < 3; ++a) {
-          FitParameter q;
-          q.name = names[rigid ? 1 : 0][a];
-          q.lower = -bound;
-          q.upper = bound;
-          q.initial = std::clamp(start(a), -0.999 * bound, 0.999 * bound);
-          q.log_scale = false;
-          parameters.push_back(q);
-        }
-        const FitResult fit = fit_least_squares(parameters, 3 * row.position_count, residuals, options.fit);
-        const Eigen::Vector3d u(fit.values[0], fit.values[1], fit.values[2]);
-        Eigen::Matrix3d covariance = Eigen::Matrix3d::Constant(kNaN);
-        if (fit.covariance.rows() == 3) covariance = fit.covariance;
-        int extra = 0;
-        if (rigid && covariance.allFinite()) {
-          // Force covariance J C J^T with J = dF/du by central differences (warm-started solves).
-          const double h = std::max(options.fit.difference_step, 1e-9) * 2 * bound;
-          Eigen::Matrix3d jacobian;
-          for (int a = 0; a < 3; ++a) {
-            Eigen::Vector3d du = Eigen::Vector3d::Zero();
-            du(a) = h;
-            const bool plus_ok = simulate(Eigen::VectorXd(u + du));
-            const Eigen::Vector3d plus = pool.cache()[p].tool_force;
-            const bool minus_ok = simulate(Eigen::VectorXd(u - du));
-            const Eigen::Vector3d minus = pool.cache()[p].tool_force;
-            extra += 2;
-            jacobian.col(a) =
-                plus_ok && minus_ok ? Eigen::Vector3d((plus - minus) / (2 * h)) : Eigen::Vector3d::Constant(kNaN);
-          }
-          covariance = jacobian * covariance * jacobian.transpose();
-        }
-        const bool solved = simulate(Eigen::VectorXd(u));  // leave the cache at the solution
-        evaluations[uz(t)] += fit.evaluations + extra + 1;
-        row.estimated_force_n = force_of(u);
-        if (rigid) row.probe_displacement_m = u;
-        for (int a = 0; a < 3; ++a) row.standard_deviation_n(a) = std::sqrt(covariance(a, a));
-        row.iterations = fit.iterations;
-        row.evaluations = fit.evaluations + extra + 1;
-        const bool at_bound = std::any_of(fit.at_bound.begin(), fit.at_bound.end(), [](bool b) { return b; });
-        row.converged = fit.converged && solved && !at_bound;
-        start = u;
-        previous = static_cast<long>(p);
-      }
+      evaluations[uz(t)] = fitter.fit_block(t, rows);
     } catch (const std::exception& ex) {
       errors[uz(t)] = ex.what();
     }
-  };
-  pool.for_each_thread(run);
+  });
   for (const std::string& error : errors) {
     if (!error.empty()) throw std::runtime_error(label + error);
   }
+  int total = 0;
+  for (int v : evaluations) total += v;
+  return total;
+}
 
-  // Residual scatter, per-frame rms and the Table III summary.
+// Rms distance (m) between simulated and tracked positions of the plan's tracked nodes; appends
+// every coordinate difference to `coordinates`.
+double tracked_rms(const FramePlan& plan, const FemFrame& frame, const Eigen::VectorXd& x,
+                   std::vector<double>& coordinates) {
+  double sum = 0;
+  for (int node : plan.tracked) {
+    const Eigen::Vector3d d = x.segment<3>(3 * ix(node)) - frame.observed_position_m.segment<3>(3 * ix(node));
+    sum += d.squaredNorm();
+    for (int a = 0; a < 3; ++a) coordinates.push_back(d(a));
+  }
+  return std::sqrt(sum / static_cast<double>(plan.tracked.size()));
+}
+
+// STEPE Table III columns of a row: the estimate projected onto the measured direction, its
+// difference from |m| and the relative error. False (row unchanged) without a measurement or
+// with |m| = 0.
+bool compare_with_measurement(ContactForceFrame& row) {
+  const double norm = row.measured_force_n.norm();
+  if (!row.has_measurement || !(norm > 0)) return false;
+  row.projected_force_n = row.estimated_force_n.dot(row.measured_force_n) / norm;
+  row.projected_difference_n = row.projected_force_n - norm;
+  row.relative_error = (row.estimated_force_n - row.measured_force_n).norm() / norm;
+  return true;
+}
+
+// After the fits: per-frame position rms, convergence, the Table III means and the position
+// noise (given, or the robust scatter of the residuals).
+void summarize_contact_fit(const FemRecordingProblem& problem, const FramePool& pool,
+                           const ContactForceOptions& options, ContactForceEstimate& e) {
   std::vector<double> coordinates;
   double measured = 0, estimated = 0, projected = 0, relative = 0;
   e.converged = true;
   for (std::size_t p = 0; p < pool.plans().size(); ++p) {
     const FramePlan& plan = pool.plans()[p];
-    const FemFrame& frame = problem.frames[uz(plan.frame)];
     ContactForceFrame& row = e.frames[p];
     if (plan.tracked.empty()) {
       e.converged = false;
@@ -1063,21 +1167,10 @@ ContactForceEstimate estimate_contact_force(const FemRecordingProblem& problem, 
       continue;
     }
     e.converged = e.converged && row.converged;
-    const Eigen::VectorXd& x = pool.cache()[p].position;
-    double sum = 0;
-    for (int node : plan.tracked) {
-      const Eigen::Vector3d d = x.segment<3>(3 * ix(node)) - frame.observed_position_m.segment<3>(3 * ix(node));
-      sum += d.squaredNorm();
-      for (int a = 0; a < 3; ++a) coordinates.push_back(d(a));
-    }
-    row.position_rms_m = std::sqrt(sum / static_cast<double>(plan.tracked.size()));
-    const double norm = row.measured_force_n.norm();
-    if (row.has_measurement && norm > 0) {
-      row.projected_force_n = row.estimated_force_n.dot(row.measured_force_n) / norm;
-      row.projected_difference_n = row.projected_force_n - norm;
-      row.relative_error = (row.estimated_force_n - row.measured_force_n).norm() / norm;
+    row.position_rms_m = tracked_rms(plan, problem.frames[uz(plan.frame)], pool.cache()[p].position, coordinates);
+    if (compare_with_measurement(row)) {
       ++e.compared_frames;
-      measured += norm;
+      measured += row.measured_force_n.norm();
       estimated += row.estimated_force_n.norm();
       projected += row.projected_force_n;
       relative += row.relative_error;
@@ -1092,7 +1185,26 @@ ContactForceEstimate estimate_contact_force(const FemRecordingProblem& problem, 
     e.mean_relative_error = relative / c;
   }
   e.position_noise_m = options.position_noise_m > 0 ? options.position_noise_m : robust_scatter(coordinates);
-  for (int v : evaluations) e.evaluations += v;
+}
+
+}  // namespace
+
+ContactForceEstimate estimate_contact_force(const FemRecordingProblem& problem, double youngs_modulus_pa,
+                                            const ContactForceOptions& options) {
+  const Timer timer;
+  const std::string label = "estimate_contact_force(" + problem.name + "): ";
+  check_contact_inputs(problem, youngs_modulus_pa, options, label);
+  ContactPlans plans =
+      plan_contact_frames(problem, options.frames, options.contact == ContactModel::rigid_probe, label);
+  FramePool pool(problem, std::move(plans.plans), options.threads, options.static_options, youngs_modulus_pa);
+  ContactFrameFitter fitter(problem, pool, options, youngs_modulus_pa, std::move(plans.probe_slots));
+
+  ContactForceEstimate e;
+  e.youngs_modulus_pa = youngs_modulus_pa;
+  e.contact = options.contact;
+  e.frames.resize(pool.plans().size());
+  e.evaluations = fit_frames_on_threads(pool, fitter, e.frames, label);
+  summarize_contact_fit(problem, pool, options, e);
   e.static_solves = pool.static_solves();
   e.wall_s = timer.wall_s();
   e.cpu_s = timer.cpu_s();
