@@ -1,5 +1,6 @@
 // Shared helpers for the pliant benchmark programs: lattices, press recordings simulated with
-// the core MSM step (no host library), and a console reporter that checks time budgets.
+// the core MSM step (core_testing's press, no host library), and a console reporter that checks
+// time budgets.
 #pragma once
 
 #include <benchmark/benchmark.h>
@@ -20,6 +21,7 @@
 
 #include "pliant/core/msm.hpp"
 #include "pliant/core/observations.hpp"
+#include "pliant/core_testing/press.hpp"
 
 #ifndef PLIANT_BENCH_BUILD_TYPE
 #define PLIANT_BENCH_BUILD_TYPE "unknown"
@@ -64,24 +66,25 @@ std::vector<int> near_regular_extents(int n) {
   return best;
 }
 
+/// The grid of the given extents standing on its last axis (core_testing::PressGrid).
+template <int Dim>
+core_testing::PressGrid press_grid(const std::vector<int>& extents, double spacing, double x0 = 0, double y0 = 0,
+                                   double y_step_sign = 1) {
+  core_testing::PressGrid grid;
+  for (int d = 0; d < Dim; ++d) grid.extents[d] = extents[static_cast<std::size_t>(d)];
+  grid.spacing = spacing;
+  grid.origin[0] = x0;
+  grid.origin[1] = y0;
+  grid.sign[1] = y_step_sign;
+  grid.support_axis = Dim - 1;
+  return grid;
+}
+
 /// Regular lattice, x fastest: id = (z * ny + y) * nx + x; the last axis is "up".
 template <int Dim, typename Scalar>
 std::vector<Scalar> lattice(const std::vector<int>& extents, double spacing, double x0 = 0, double y0 = 0,
                             double y_step_sign = 1) {
-  std::vector<Scalar> rest;
-  const int nx = extents[0];
-  const int ny = extents[1];
-  const int nz = Dim == 3 ? extents[2] : 1;
-  for (int z = 0; z < nz; ++z) {
-    for (int y = 0; y < ny; ++y) {
-      for (int x = 0; x < nx; ++x) {
-        rest.push_back(static_cast<Scalar>(x0 + spacing * x));
-        rest.push_back(static_cast<Scalar>(y0 + y_step_sign * spacing * y));
-        if (Dim == 3) rest.push_back(static_cast<Scalar>(spacing * z));
-      }
-    }
-  }
-  return rest;
+  return core_testing::grid_rest<Dim, Scalar>(press_grid<Dim>(extents, spacing, x0, y0, y_step_sign));
 }
 
 /// An MSM model with its memory. Not copyable: the model points into `block`.
@@ -125,23 +128,8 @@ struct OwnedState {
 
 // --- deterministic noise -------------------------------------------------------------------------
 
-/// splitmix64: a fixed, platform-independent hash.
-inline std::uint64_t mix(std::uint64_t x) {
-  x += 0x9e3779b97f4a7c15ULL;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
-  return x ^ (x >> 31);
-}
-
-/// Zero-mean, unit-variance noise from (key): Irwin-Hall sum of 4 uniforms, rescaled.
-inline double unit_noise(std::uint64_t key) {
-  double sum = 0;
-  for (std::uint64_t k = 0; k < 4; ++k) {
-    const std::uint64_t bits = mix(key * 4 + k) >> 11;  // 53 bits
-    sum += static_cast<double>(bits) / 9007199254740992.0 - 0.5;
-  }
-  return sum * std::sqrt(3.0);
-}
+using core_testing::mix;         // splitmix64
+using core_testing::unit_noise;  // zero-mean, unit-variance noise from a key
 
 // --- press recordings ------------------------------------------------------------------------------
 
@@ -240,65 +228,38 @@ inline PressPlan block_press_plan() {
   return plan;
 }
 
+/// The plan's press by core_testing::simulate_grid_press (in double, hashed noise), into `out`.
 template <int Dim, typename Scalar>
 void simulate_press(const PressPlan& plan, PressRecording<Dim, Scalar>& out) {
-  using VecD = Eigen::Matrix<double, Dim, 1>;
-  const std::vector<double> truth_rest =
-      lattice<Dim, double>(plan.extents, plan.spacing, plan.x0, plan.y0, plan.y_step_sign);
-  const int n = static_cast<int>(truth_rest.size() / Dim);
+  const core_testing::PressGrid grid = press_grid<Dim>(plan.extents, plan.spacing, plan.x0, plan.y0, plan.y_step_sign);
+  const int n = core_testing::grid_particle_count<Dim>(grid);
   out.particle_count = n;
   out.tool = plan.tool;
   out.spacing = plan.spacing;
-  out.fixed.assign(static_cast<std::size_t>(n), 0);
-  const int bottom = plan.extents[0] * (Dim == 2 ? 1 : plan.extents[1]);  // ids of the bottom layer
-  for (int i = 0; i < bottom; ++i) out.fixed[static_cast<std::size_t>(i)] = 1;
+  out.fixed = core_testing::grid_support<Dim>(grid);
   out.drivable = {plan.tool};
   out.window = DrivenWindow{};
   out.window.id = plan.tool;
 
-  // Truth run in double on the noise-free rest shape.
-  OwnedModel<Dim, double> truth_model(truth_rest, out.fixed, out.drivable);
-  if (truth_model.status != Status::ok) {
-    out.status = truth_model.status;
-    return;
-  }
-  OwnedState<Dim, double> truth(truth_model.model);
+  core_testing::PressMotion motion;
+  motion.tool = plan.tool;
+  for (int d = 0; d < Dim; ++d) motion.travel[d] = plan.press[static_cast<std::size_t>(d)];
+  motion.ramp_s = plan.ramp_s;
+  motion.duration_s = plan.duration_s;
+  motion.rate_hz = plan.rate_hz;
+  core_testing::PositionNoise noise;
+  noise.source = core_testing::NoiseSource::hashed;
+  noise.std = plan.noise * plan.spacing;
+  noise.seed = plan.seed;
   MsmParams<Dim, double> params;
   params.msm_beta = plan.msm_beta;
-  const int frames = static_cast<int>(std::lround(plan.duration_s * plan.rate_hz)) + 1;
-  const double sigma = plan.noise * plan.spacing;
-  auto record = [&](int frame) {
-    for (int i = 0; i < n; ++i) {
-      for (int d = 0; d < Dim; ++d) {
-        constexpr std::uint64_t kPrime = 1000003;
-        const std::uint64_t key =
-            (plan.seed * kPrime + static_cast<std::uint64_t>(frame)) * kPrime + static_cast<std::uint64_t>(i * Dim + d);
-        out.positions.push_back(static_cast<Scalar>(truth.state.position[i](d) + sigma * unit_noise(key)));
-      }
-    }
-  };
-  out.times.push_back(0.0);
-  record(0);
-  const double dt = 1.0 / plan.rate_hz;
-  for (int k = 1; k < frames; ++k) {
-    const double t = k * dt;
-    const double ramp = std::clamp(t / plan.ramp_s, 0.0, 1.0);
-    VecD target = truth_model.model.rest[plan.tool];
-    for (int d = 0; d < Dim; ++d) target(d) += ramp * plan.press[static_cast<std::size_t>(d)];
-    MsmStepInput<Dim, double> input;
-    input.dt = dt;
-    input.driven.ids = &plan.tool;
-    input.driven.positions = &target;
-    input.driven.count = 1;
-    const Status stepped = msm_step(truth_model.model, params, input, truth.state);
-    if (stepped != Status::ok) {
-      out.status = stepped;
-      return;
-    }
-    out.times.push_back(t);
-    record(k);
-  }
-  out.rest.assign(out.positions.begin(), out.positions.begin() + n * Dim);
+  core_testing::PressFrames<Scalar> recorded;
+  out.status = core_testing::simulate_grid_press(grid, params, motion, noise, recorded);
+  out.times = std::move(recorded.times_s);
+  out.positions = std::move(recorded.positions);
+  if (out.status != Status::ok) return;
+  const int frames = out.frame_count();
+  out.rest.assign(out.positions.begin(), out.positions.begin() + static_cast<std::ptrdiff_t>(n) * Dim);
   for (int k = 0; k < frames; ++k) {
     for (int i = 0; i < n; ++i) {
       out.frames.push_back(Eigen::Map<const Eigen::Matrix<Scalar, Dim, 1>>(
@@ -306,7 +267,6 @@ void simulate_press(const PressPlan& plan, PressRecording<Dim, Scalar>& out) {
     }
     out.tool_targets.push_back(out.frames[static_cast<std::size_t>(k * n + plan.tool)]);
   }
-  out.status = Status::ok;
 }
 
 // --- budgets and the program entry ---------------------------------------------------------------

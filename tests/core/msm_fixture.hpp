@@ -5,23 +5,20 @@
 #include <vector>
 
 #include "pliant/core/msm.hpp"
+#include "pliant/core_testing/press_grid.hpp"
 
 namespace pliant::test {
 
-/// Regular lattice, ids x-fastest: id = (z * ny + y) * nx + x. Spacing `h`.
+/// Regular lattice, ids x-fastest: id = (z * ny + y) * nx + x. Spacing `h`, particle 0 at the
+/// origin (core_testing's press grid).
 template <int Dim, typename Scalar>
 std::vector<Scalar> lattice(int nx, int ny, int nz, double h) {
-  std::vector<Scalar> rest;
-  for (int z = 0; z < (Dim == 3 ? nz : 1); ++z) {
-    for (int y = 0; y < ny; ++y) {
-      for (int x = 0; x < nx; ++x) {
-        rest.push_back(static_cast<Scalar>(h * x));
-        rest.push_back(static_cast<Scalar>(h * y));
-        if (Dim == 3) rest.push_back(static_cast<Scalar>(h * z));
-      }
-    }
-  }
-  return rest;
+  core_testing::PressGrid grid;
+  grid.extents[0] = nx;
+  grid.extents[1] = ny;
+  grid.extents[2] = nz;
+  grid.spacing = h;
+  return core_testing::grid_rest<Dim, Scalar>(grid);
 }
 
 /// A model and one state, with their memory.

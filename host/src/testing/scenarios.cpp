@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <functional>
-#include <random>
 #include <stdexcept>
+#include <utility>
 
+#include "pliant/core_testing/press.hpp"
 #include "pliant/host/msm_setup.hpp"
 
 namespace pliant::host {
@@ -51,24 +53,33 @@ constexpr double kGravityCantilever = 0.01;
 constexpr double kGravityRing = 0.003;
 constexpr double kGravityDome = 0.08;
 
-double ramp(double t, double ramp_s) { return std::clamp((t - kLeadIn_s) / ramp_s, 0.0, 1.0); }
+// A grid object from core_testing's press grid (the one the core tests and benchmarks press):
+// rest shape, the support layer as fixed ids and the tool on the top-centre particle.
+template <int Dim>
+void place_grid(const core_testing::PressGrid& grid, ScenarioPlan& plan) {
+  plan.rest = core_testing::grid_rest<Dim, double>(grid);
+  const std::vector<std::uint8_t> support = core_testing::grid_support<Dim>(grid);
+  for (std::size_t i = 0; i < support.size(); ++i) {
+    if (support[i] != 0) plan.fixed.push_back(static_cast<int>(i));
+  }
+  plan.tool = core_testing::grid_top_centre<Dim>(grid);
+}
 
 ScenarioPlan foam_press(bool release) {
   ScenarioPlan plan;
   plan.dimension = 2;
   plan.length_unit = "px";
   plan.spacing = 100.0;
-  const int cols = 8;
-  const int rows = 4;
   // Image coordinates: y grows downward; row 0 is the bottom row on the support.
-  for (int r = 0; r < rows; ++r) {
-    for (int c = 0; c < cols; ++c) {
-      plan.rest.push_back(560.0 + 100.0 * c);
-      plan.rest.push_back(840.0 - 100.0 * r);
-      if (r == 0) plan.fixed.push_back(r * cols + c);
-    }
-  }
-  plan.tool = 3 * cols + 4;
+  core_testing::PressGrid grid;
+  grid.extents[0] = 8;
+  grid.extents[1] = 4;
+  grid.spacing = plan.spacing;
+  grid.origin[0] = 560.0;
+  grid.origin[1] = 840.0;
+  grid.sign[1] = -1.0;
+  grid.support_axis = 1;
+  place_grid<2>(grid, plan);  // the tool on particle 28
   plan.duration_s = kLeadIn_s + 4.0;
   if (release) {
     plan.release_s = plan.duration_s;
@@ -94,17 +105,13 @@ ScenarioPlan block_press(bool release, const ScenarioOptions::BlockGrid& grid) {
   const int nx = grid.nx;
   const int ny = grid.ny;
   const int nz = grid.nz;
-  for (int z = 0; z < nz; ++z) {
-    for (int y = 0; y < ny; ++y) {
-      for (int x = 0; x < nx; ++x) {
-        plan.rest.push_back(0.01 * x);
-        plan.rest.push_back(0.01 * y);
-        plan.rest.push_back(0.01 * z);
-        if (z == 0) plan.fixed.push_back((z * ny + y) * nx + x);
-      }
-    }
-  }
-  plan.tool = ((nz - 1) * ny + ny / 2) * nx + nx / 2;
+  core_testing::PressGrid block;
+  block.extents[0] = nx;
+  block.extents[1] = ny;
+  block.extents[2] = nz;
+  block.spacing = plan.spacing;
+  block.support_axis = 2;
+  place_grid<3>(block, plan);  // the tool on the top-centre particle
   plan.duration_s = kLeadIn_s + 3.0;
   if (release) {
     plan.release_s = plan.duration_s;
@@ -242,11 +249,6 @@ void simulate(const ScenarioPlan& plan, const ScenarioOptions& options, detail::
   MsmSetupOptions setup;
   setup.clusters.radius_factor = options.cluster_radius_factor;
   auto model = build_msm_model<Dim>(recording, setup);
-  const std::size_t bytes = msm_state_workspace_size(model->model);
-  auto block = std::make_unique<unsigned char[]>(bytes);
-  Arena arena(block.get(), bytes);
-  MsmState<Dim, double> state;
-  require_ok(msm_state_init(arena, model->model, state), "scenario state");
   MsmParams<Dim, double> params = base_params<Dim>(recording, options.msm_alpha);
   params.msm_beta = options.msm_beta;
   // The concealed effect acts on the simulation only; the recording never declares it.
@@ -274,46 +276,26 @@ void simulate(const ScenarioPlan& plan, const ScenarioOptions& options, detail::
     effect.details["cluster_count"] = model->model.cluster_count;
   }
 
-  const int frames = static_cast<int>(std::lround(plan.duration_s * plan.rate_hz)) + 1;
-  const auto n = static_cast<std::size_t>(recording.particle_count);
-  recording.frame_times_s.resize(static_cast<std::size_t>(frames));
-  recording.positions.assign(static_cast<std::size_t>(frames) * n * Dim, 0.0);
-  std::mt19937_64 rng(options.seed);
-  std::normal_distribution<double> normal(0.0, 1.0);
-  const double sigma = options.noise * plan.spacing;
-  auto record = [&](int frame) {
-    for (std::size_t i = 0; i < n; ++i) {
-      for (int d = 0; d < Dim; ++d) {
-        const double noise = sigma > 0 ? sigma * normal(rng) : 0.0;
-        recording.positions[(static_cast<std::size_t>(frame) * n + i) * Dim + static_cast<std::size_t>(d)] =
-            state.position[i](d) + noise;
-      }
-    }
-  };
-  record(0);
-  recording.frame_times_s[0] = 0.0;
-  const double dt = 1.0 / plan.rate_hz;
-  const int substeps = options.substeps;
-  const double step_dt = dt / substeps;
+  // The press itself: core_testing's, shared with the core tests and the benchmarks.
+  core_testing::PressMotion motion;
+  motion.tool = plan.tool;
   const double travel = options.depth > 0.0 ? options.depth * plan.height : plan.travel;
-  for (int k = 1; k < frames; ++k) {
-    recording.frame_times_s[static_cast<std::size_t>(k)] = k * dt;
-    for (int j = 1; j <= substeps; ++j) {
-      // With one substep this is k * dt, the frame time itself.
-      const double t = static_cast<double>((k - 1) * substeps + j) * step_dt;
-      Eigen::Matrix<double, Dim, 1> target = model->model.rest[plan.tool];
-      const double progress = ramp(t, 1.0);
-      for (int d = 0; d < Dim; ++d) target(d) += (plan.tool_direction[static_cast<std::size_t>(d)] * travel) * progress;
-      MsmStepInput<Dim, double> input;
-      input.dt = step_dt;
-      const bool driven = t <= plan.release_s;
-      input.driven.ids = &plan.tool;
-      input.driven.positions = &target;
-      input.driven.count = driven ? 1 : 0;
-      require_ok(msm_step(model->model, params, input, state), "scenario step");
-    }
-    record(k);
-  }
+  for (int d = 0; d < Dim; ++d) motion.travel[d] = plan.tool_direction[static_cast<std::size_t>(d)] * travel;
+  motion.lead_in_s = kLeadIn_s;
+  motion.ramp_s = 1.0;
+  motion.release_s = plan.release_s;
+  motion.duration_s = plan.duration_s;
+  motion.rate_hz = plan.rate_hz;
+  motion.steps_per_frame = options.substeps;
+  motion.clock = core_testing::PressClock::step_count;
+  core_testing::PositionNoise noise;
+  noise.source = core_testing::NoiseSource::normal_mt19937_64;
+  noise.std = options.noise * plan.spacing;
+  noise.seed = options.seed;
+  core_testing::PressFrames<double> frames;
+  require_ok(core_testing::simulate_press(model->model, params, motion, noise, frames), "scenario step");
+  recording.frame_times_s = std::move(frames.times_s);
+  recording.positions = std::move(frames.positions);
 }
 
 void check_options(const ScenarioOptions& options) {

@@ -2,7 +2,8 @@
 // concealed suites that prove `pliant diagnose`.
 //
 // Each scenario runs the core MSM model (double precision) with the true parameters, records
-// every particle every frame and adds Gaussian position noise. The truth goes into a separate
+// every particle every frame and adds Gaussian position noise (the press loop is
+// core_testing::simulate_press, shared with the core tests and the benchmarks). The truth goes into a separate
 // truth.json document that no estimator reads; the recording carries no hint of it.
 //
 // By default the generator is the estimators' own model: one MSM step per frame interval,
