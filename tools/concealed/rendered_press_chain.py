@@ -31,7 +31,7 @@ median and largest error). Always exits 0.
     options: --count N (default 8) --seed S (default 5) --keep (keep the frames)
              --support SPEC (passed to pliant track; default auto)
 
-Needs numpy (Debian python3-numpy). About 1 minute per case on one core.
+Needs numpy (Debian python3-numpy). One to three minutes per case on the shared 2-core machine.
 """
 import argparse
 import json
