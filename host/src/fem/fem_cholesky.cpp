@@ -417,4 +417,22 @@ void BlockCholesky::solve(Eigen::Ref<Eigen::VectorXd> rhs) {
   for (int k = 0; k < n; ++k) rhs.segment<3>(3 * perm_[uz(k)]) = permuted_.segment<3>(3 * k);
 }
 
+std::vector<std::vector<int>> subset_block_pattern(const Eigen::SparseMatrix<double>& a, const std::vector<int>& index,
+                                                   int subset_count) {
+  std::vector<std::vector<int>> adjacency(static_cast<std::size_t>(subset_count));
+  for (int col = 0; col < a.outerSize(); col += 3) {
+    const int fb = index[static_cast<std::size_t>(col / 3)];
+    if (fb < 0) continue;
+    for (Eigen::SparseMatrix<double>::InnerIterator it(a, col); it; ++it) {
+      const int fa = index[static_cast<std::size_t>(static_cast<int>(it.row()) / 3)];
+      if (fa >= 0 && fa != fb) adjacency[static_cast<std::size_t>(fa)].push_back(fb);
+    }
+  }
+  for (auto& list : adjacency) {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+  }
+  return adjacency;
+}
+
 }  // namespace pliant::host::fem::detail

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 
 namespace pliant::host::fem::detail {
 
@@ -71,5 +72,34 @@ class BlockCholesky {
   Eigen::VectorXd diagonal_;
   Eigen::VectorXd gather_;
 };
+
+/// The block pattern of a node-major sparse matrix `a` (3x3 blocks) restricted to a subset of
+/// its nodes: index[node] is the node's row in the subset, or -1 when it is left out.
+/// adjacency[i] lists the other subset nodes block row i touches, sorted, for analyze().
+std::vector<std::vector<int>> subset_block_pattern(const Eigen::SparseMatrix<double>& a, const std::vector<int>& index,
+                                                   int subset_count);
+
+/// Adds the lower triangle of `a` restricted to the subset (index as above) into the factor's
+/// block slots, each entry times scale(node_row, node_col) (original node numbers). The factor
+/// must have been analysed with subset_block_pattern(a, index, ...) or a wider pattern.
+template <typename Scale>
+void add_subset_lower(const Eigen::SparseMatrix<double>& a, const std::vector<int>& index, BlockCholesky& cholesky,
+                      Scale&& scale) {
+  double* values = cholesky.values();
+  for (int col = 0; col < a.outerSize(); ++col) {
+    const int node_col = col / 3;
+    const int fq = index[static_cast<std::size_t>(node_col)];
+    if (fq < 0) continue;
+    for (Eigen::SparseMatrix<double>::InnerIterator it(a, col); it; ++it) {
+      const int node_row = static_cast<int>(it.row()) / 3;
+      const int fa = index[static_cast<std::size_t>(node_row)];
+      if (fa < fq) continue;  // the slot of (fa, fq) with fa >= fq holds both triangles' blocks
+      const BlockCholesky::Slot slot = cholesky.slot(fa, fq);
+      const int i = static_cast<int>(it.row()) % 3;
+      const int j = col % 3;
+      values[slot.offset + i * slot.row_stride + j * slot.col_stride] += it.value() * scale(node_row, node_col);
+    }
+  }
+}
 
 }  // namespace pliant::host::fem::detail

@@ -2,7 +2,6 @@
 
 #include <Eigen/SparseCore>
 
-#include <algorithm>
 #include <stdexcept>
 #include <string>
 
@@ -37,44 +36,6 @@ std::vector<int> relaxed_index(int node_count, const std::vector<int>& probed, c
   return index;
 }
 
-// The block pattern of `a` on the relaxed nodes, for the symbolic analysis.
-std::vector<std::vector<int>> relaxed_adjacency(const Eigen::SparseMatrix<double>& a, const std::vector<int>& index,
-                                                int relaxed_count) {
-  std::vector<std::vector<int>> adjacency(uz(relaxed_count));
-  for (int col = 0; col < a.outerSize(); col += 3) {
-    const int fb = index[uz(col / 3)];
-    if (fb < 0) continue;
-    for (Eigen::SparseMatrix<double>::InnerIterator it(a, col); it; ++it) {
-      const int fa = index[uz(static_cast<int>(it.row()) / 3)];
-      if (fa >= 0 && fa != fb) adjacency[uz(fa)].push_back(fb);
-    }
-  }
-  for (auto& list : adjacency) {
-    std::sort(list.begin(), list.end());
-    list.erase(std::unique(list.begin(), list.end()), list.end());
-  }
-  return adjacency;
-}
-
-// Scatters the lower triangle of a_ff into the factor's block slots.
-void assemble_relaxed(const Eigen::SparseMatrix<double>& a, const std::vector<int>& index,
-                      detail::BlockCholesky& cholesky) {
-  cholesky.set_zero();
-  double* values = cholesky.values();
-  for (int col = 0; col < a.outerSize(); ++col) {
-    const int fq = index[uz(col / 3)];
-    if (fq < 0) continue;
-    for (Eigen::SparseMatrix<double>::InnerIterator it(a, col); it; ++it) {
-      const int fa = index[uz(static_cast<int>(it.row()) / 3)];
-      if (fa < fq) continue;  // the slot of (fa, fq) with fa >= fq holds both triangles' blocks
-      const detail::BlockCholesky::Slot slot = cholesky.slot(fa, fq);
-      const int i = static_cast<int>(it.row()) % 3;
-      const int j = col % 3;
-      values[slot.offset + i * slot.row_stride + j * slot.col_stride] += it.value();
-    }
-  }
-}
-
 }  // namespace
 
 Eigen::MatrixXd condensed_stiffness(const FemModel& model, const Eigen::Ref<const Eigen::VectorXd>& position_m,
@@ -97,8 +58,9 @@ Eigen::MatrixXd condensed_stiffness(const FemModel& model, const Eigen::Ref<cons
 
   detail::BlockCholesky cholesky;
   if (relaxed_count > 0) {
-    cholesky.analyze(relaxed_count, relaxed_adjacency(a, index, relaxed_count));
-    assemble_relaxed(a, index, cholesky);
+    cholesky.analyze(relaxed_count, detail::subset_block_pattern(a, index, relaxed_count));
+    cholesky.set_zero();
+    detail::add_subset_lower(a, index, cholesky, [](int, int) { return 1.0; });
     if (!cholesky.factorize()) {
       throw std::runtime_error("condensed_stiffness: the relaxed nodes are not held against rigid motion");
     }

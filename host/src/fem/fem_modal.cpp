@@ -29,43 +29,18 @@ class ShiftSolve {
       : model_(model), free_index_(free_index), free_count_(free_count), stiffness_(stiffness_matrix(model, position)) {
     // The pattern of K (element pairs, and two element rings under the nodal volumetric
     // formulation) on the free nodes.
-    std::vector<std::vector<int>> adjacency(uz(free_count));
-    for (int col = 0; col < stiffness_.outerSize(); col += 3) {
-      for (Eigen::SparseMatrix<double>::InnerIterator it(stiffness_, col); it; ++it) {
-        const int fa = free_index[uz(static_cast<int>(it.row()) / 3)];
-        const int fb = free_index[uz(col / 3)];
-        if (fa >= 0 && fb >= 0 && fa != fb) adjacency[uz(fa)].push_back(fb);
-      }
-    }
-    for (auto& list : adjacency) {
-      std::sort(list.begin(), list.end());
-      list.erase(std::unique(list.begin(), list.end()), list.end());
-    }
-    cholesky_.analyze(free_count, adjacency);
+    cholesky_.analyze(free_count, detail::subset_block_pattern(stiffness_, free_index, free_count));
     scratch_.setZero(3 * free_count);
   }
   Eigen::Index rows() const { return 3 * static_cast<Eigen::Index>(free_count_); }
   Eigen::Index cols() const { return rows(); }
   void set_shift(double sigma) {
     cholesky_.set_zero();
-    double* values = cholesky_.values();
     const Eigen::VectorXd& mass = model_.lumped_mass_kg();
-    // Lower triangle of M^-1/2 K M^-1/2 on the free nodes, entry by entry into its block slot.
-    for (int col = 0; col < stiffness_.outerSize(); ++col) {
-      const int node_col = col / 3;
-      const int fq = free_index_[uz(node_col)];
-      if (fq < 0) continue;
-      for (Eigen::SparseMatrix<double>::InnerIterator it(stiffness_, col); it; ++it) {
-        const int node_row = static_cast<int>(it.row()) / 3;
-        const int fa = free_index_[uz(node_row)];
-        if (fa < fq) continue;  // the slot of (fa, fq) with fa >= fq holds both triangles' blocks
-        const detail::BlockCholesky::Slot slot = cholesky_.slot(fa, fq);
-        const int i = static_cast<int>(it.row()) % 3;
-        const int j = col % 3;
-        values[slot.offset + i * slot.row_stride + j * slot.col_stride] +=
-            it.value() / std::sqrt(mass[node_row] * mass[node_col]);
-      }
-    }
+    // Lower triangle of M^-1/2 K M^-1/2 on the free nodes.
+    detail::add_subset_lower(stiffness_, free_index_, cholesky_,
+                             [&](int row, int col) { return 1.0 / std::sqrt(mass[row] * mass[col]); });
+    double* values = cholesky_.values();
     for (int i = 0; i < free_count_; ++i) {
       const detail::BlockCholesky::Slot slot = cholesky_.slot(i, i);
       for (int d = 0; d < 3; ++d) values[slot.offset + d * (slot.row_stride + slot.col_stride)] -= sigma;
