@@ -321,9 +321,12 @@ typedef struct pliant_guard_config_s {
   int32_t wrench_frozen_samples; /**< bit-identical wrench samples meaning frozen; 0 (default): off */
 
   /* --- status words: set bits are faults -------------------------------------------- */
-  uint32_t gripper_fault_mask; /**< default 0xffffffff */
-  uint32_t wrench_fault_mask;  /**< default 0x18fe (ATI NETCANOEM status bits 1-7, 11, 12) */
-  uint32_t camera_fault_mask;  /**< default 0xffffffff */
+  /* Defaults: the HAL's status words plus the stream monitor's flags 17-21 (0x003e0000),
+   * docs/grasp_guard.md "Status words". */
+  uint32_t gripper_fault_mask; /**< default 0x003eff00: the fault code byte 8-15 (Robotiq gFLT | kFLT << 4);
+                                    activated, moving, object detected, at target are states */
+  uint32_t wrench_fault_mask;  /**< default 0x003e18fe (ATI NETCANOEM status bits 1-7, 11, 12) */
+  uint32_t camera_fault_mask;  /**< default 0x003e0001: the device marked the frame unusable */
 
   /* --- verdicts and hysteresis ------------------------------------------------------- */
   /** Verdict of a fault per PLIANT_SOURCE_* (LIMIT or STOP). Defaults: gripper, wrench and

@@ -203,7 +203,7 @@ std::vector<Fault> faults() {
        GuardReason::invalid_input, GuardSource::estimate},
       {"estimate invalid", [](Rig& r) { r.in.estimate.valid = false; }, [](Rig& r) { r.in.estimate.valid = true; },
        GuardReason::invalid_input, GuardSource::estimate},
-      {"gripper fault bits", [](Rig& r) { r.in.gripper.status_bits = 0x0e; },
+      {"gripper fault code", [](Rig& r) { r.in.gripper.status_bits = 0x0eu << 8; },
        [](Rig& r) { r.in.gripper.status_bits = 0; }, GuardReason::sensor_fault, GuardSource::gripper},
       {"ATI supply low", [](Rig& r) { r.in.wrench.status_bits = 1u << 5; }, [](Rig& r) { r.in.wrench.status_bits = 0; },
        GuardReason::sensor_fault, GuardSource::wrench},
@@ -327,6 +327,32 @@ TEST(GraspGuard, StatusBitsOutsideTheMaskAreIgnored) {
   EXPECT_EQ(rig.run(20), 0) << describe(rig.out);
   rig.in.wrench.status_bits = 1u << 14;  // CAN bus error: transport degraded, not sensor invalid
   EXPECT_EQ(rig.run(5), 0) << describe(rig.out);
+}
+
+// With the default masks, a gripper's state bits (activated, moving, object detected, at
+// target) and a camera's partial frame are not faults; every fault-code value, every stream
+// monitor flag except the sequence gap, and the frame's device fault are.
+TEST(GraspGuard, DefaultMasksTellStatesFromFaults) {
+  Rig rig;
+  rig.in.gripper.status_bits = 0x0fu;
+  rig.in.deformation.status_bits = 1u << 1;
+  rig.in.wrench.status_bits = 1u << 16;
+  EXPECT_EQ(rig.run(20), 0) << describe(rig.out);
+  for (std::uint32_t code = 1; code <= 0xff; code += 0x11) {
+    rig.in.gripper.status_bits = 0x0fu | code << 8;
+    EXPECT_TRUE(has(rig.cycle(), GuardReason::sensor_fault)) << code << " " << describe(rig.out);
+    EXPECT_EQ(rig.out.fault_sources, 1u << static_cast<unsigned>(GuardSource::gripper)) << code;
+  }
+  rig.in.gripper.status_bits = 0x0fu;
+  for (unsigned bit = 17; bit <= 21; ++bit) {
+    rig.in.wrench.status_bits = 1u << bit;
+    EXPECT_TRUE(has(rig.cycle(), GuardReason::sensor_fault)) << bit << " " << describe(rig.out);
+    EXPECT_NE(rig.out.fault_sources & (1u << static_cast<unsigned>(GuardSource::wrench)), 0u) << bit;
+  }
+  rig.in.wrench.status_bits = 0;
+  rig.in.deformation.status_bits = 1u;
+  EXPECT_TRUE(has(rig.cycle(), GuardReason::sensor_fault)) << describe(rig.out);
+  EXPECT_NE(rig.out.fault_sources & (1u << static_cast<unsigned>(GuardSource::camera)), 0u);
 }
 
 TEST(GraspGuard, BackwardsStampIsInvalid) {

@@ -340,34 +340,41 @@ TEST(HalGuardInputs, ReadsBecomeGuardSamples) {
   EXPECT_EQ(d.strain, 0.02);
 }
 
+// The small grasp on a stepped clock and a grasp guard with its default masks on the plant's
+// model (squeezed along x), with a coarse prediction grid to keep the tests fast.
+struct GuardedPlant {
+  test::SteppedClock t;
+  SimulatedGrasp plant{t.clock};
+  GraspGuardConfig config;
+  std::vector<unsigned char> block;
+  GraspGuard<3, double> guard;
+  Status status = Status::not_initialized;
+  GuardedPlant() {
+    if (plant.configure(test::small_grasp()) != HalStatus::ok) return;
+    config.prediction_beta_points = 3;
+    config.prediction_closure_points = 4;
+    block.resize(grasp_guard_workspace_size(plant.model(), config));
+    Arena arena(block.data(), block.size());
+    GraspObject<3, double> object;
+    object.squeeze_axis = Eigen::Vector3d(1, 0, 0);
+    status = grasp_guard_init(arena, plant.model(), object, config, guard);
+  }
+};
+
 // The conversions feed the guard: a bus-off read makes its verdict not ok in that cycle.
 TEST(HalGuardInputs, BusOffReachesTheGuardInTheSameCycle) {
-  test::SteppedClock t;
-  SimulatedGrasp plant(t.clock);
-  ASSERT_EQ(plant.configure(test::small_grasp()), HalStatus::ok);
-  std::vector<int> all(static_cast<std::size_t>(plant.particle_count()));
-  for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int>(i);
-  GraspGuardConfig config;
-  config.prediction_beta_points = 3;
-  config.prediction_closure_points = 4;
-  config.gripper_fault_mask = kGripperFaultMask;  // the activated bit is not a fault
-  std::vector<unsigned char> block(grasp_guard_workspace_size(plant.model(), config));
-  Arena arena(block.data(), block.size());
-  GraspGuard<3, double> guard;
-  GraspObject<3, double> object;
-  object.squeeze_axis = Eigen::Vector3d(1, 0, 0);
-  ASSERT_EQ(grasp_guard_init(arena, plant.model(), object, config, guard), Status::ok);
+  GuardedPlant rig;
+  ASSERT_EQ(rig.status, Status::ok);
+  test::SteppedClock& t = rig.t;
+  SimulatedGrasp& plant = rig.plant;
+  GraspGuard<3, double>& guard = rig.guard;
   MockForceTorqueSensor ft(plant, t.clock);
   MockGripper gripper(plant, t.clock);
   ASSERT_EQ(ft.configure(), HalStatus::ok);
   ASSERT_EQ(gripper.configure(), HalStatus::ok);
   ASSERT_EQ(ft.start(), HalStatus::ok);
   ASSERT_EQ(gripper.start(), HalStatus::ok);
-  FaultEvent bus_off;
-  bus_off.kind = FaultKind::bus_off;
-  bus_off.start_s = 1.0105;
-  bus_off.duration_s = 0.005;
-  ASSERT_EQ(ft.add_fault(bus_off), HalStatus::ok);
+  ASSERT_EQ(ft.add_fault(test::event(FaultKind::bus_off, 1.0105, 0.005)), HalStatus::ok);
   GraspGuardInput in;
   in.deformation.valid = true;
   in.deformation.strain = 0;
@@ -394,6 +401,63 @@ TEST(HalGuardInputs, BusOffReachesTheGuardInTheSameCycle) {
   }
   EXPECT_EQ(ft.fault_counters().of(FaultKind::bus_off), 5u);
   EXPECT_EQ(ft.counters().bus_off, 5u);
+}
+
+// The mock gripper with the guard's default masks: closing on the plant (activated, moving,
+// then object detected) is never a fault; the fault code the mock reports during a fault_bits
+// event is, in the cycle it arrives, and the verdict clears after it.
+TEST(HalGuardInputs, TheDefaultMaskReadsTheMockGrippersStatesAndFaults) {
+  GuardedPlant rig;
+  ASSERT_EQ(rig.status, Status::ok);
+  test::SteppedClock& t = rig.t;
+  SimulatedGrasp& plant = rig.plant;
+  GraspGuard<3, double>& guard = rig.guard;
+  const GraspGuardConfig& config = rig.config;
+  MockGripper gripper(plant, t.clock);
+  ASSERT_EQ(gripper.configure(), HalStatus::ok);
+  ASSERT_EQ(gripper.start(), HalStatus::ok);
+  ASSERT_EQ(gripper.add_fault(test::event(FaultKind::fault_bits, 1.0305, 0.005)), HalStatus::ok);
+  GripperCommand close;
+  close.kind = GripperCommandKind::move;
+  close.width_m = 0.0;
+  close.speed_m_per_s = 0.02;
+  close.force_n = 5.0;
+  ASSERT_EQ(gripper.write(close), HalStatus::ok);
+  GraspGuardInput in;
+  in.wrench.valid = in.deformation.valid = in.estimate.valid = true;
+  for (double& w : in.wrench.wrench) w = 0;
+  in.deformation.strain = 0;
+  in.estimate.msm_beta = 0.5;
+  in.estimate.msm_beta_std = 0.01;
+  GraspGuardOutput out;
+  std::uint32_t states_seen = 0;
+  int faulted_cycles = 0;
+  int clean_after_fault = 0;
+  for (int k = 0; k < 60; ++k) {
+    t.step();
+    in.now_s = in.wrench.stamp_s = in.deformation.stamp_s = in.estimate.stamp_s = t.now();
+    GripperReading g;
+    ASSERT_EQ(gripper.read(g), HalStatus::ok) << k;
+    update_gripper_sample(HalStatus::ok, g, 0, in.gripper);
+    ASSERT_EQ(grasp_guard_update(guard, in, out), Status::ok);
+    const bool faulted = gripper_fault_code(g.header.status_bits) != 0;
+    states_seen |= g.header.status_bits & 0x0fu;
+    faulted_cycles += faulted ? 1 : 0;
+    const bool gripper_fault = (out.fault_sources & (1u << static_cast<unsigned>(GuardSource::gripper))) != 0;
+    // Before the fault and once the latch has seen clear_samples clean samples after it: no
+    // gripper fault; during it: a sensor fault in every cycle.
+    const bool latched = faulted_cycles > 0 && clean_after_fault < config.clear_samples;
+    if (faulted) {
+      EXPECT_TRUE(gripper_fault) << k;
+      EXPECT_EQ(out.reason, GuardReason::sensor_fault) << k;
+    } else if (!latched) {
+      EXPECT_FALSE(gripper_fault) << k << " status " << g.header.status_bits << " " << guard_reason_name(out.reason);
+    }
+    clean_after_fault = faulted ? 0 : clean_after_fault + (faulted_cycles > 0 ? 1 : 0);
+  }
+  EXPECT_EQ(faulted_cycles, 5);
+  EXPECT_NE(states_seen & kGripperActivated, 0u);
+  EXPECT_NE(states_seen & kGripperMoving, 0u);
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 
 #include "pliant/hal/mock/mock_force_torque.hpp"
 #include "pliant/hal/mock/mock_gripper.hpp"
@@ -23,6 +24,17 @@ inline SimulatedGraspConfig small_grasp(double beta = 0.5) {
   c.period_s = 0.001;
   c.initial_width_m = 0.034;
   return c;
+}
+
+/// One scheduled fault; `value` NaN: the kind's default.
+inline FaultEvent event(FaultKind kind, double start_s, double duration_s,
+                        double value = std::numeric_limits<double>::quiet_NaN()) {
+  FaultEvent e;
+  e.kind = kind;
+  e.start_s = start_s;
+  e.duration_s = duration_s;
+  e.value = value;
+  return e;
 }
 
 /// Clock at t = 1 s stepped in whole milliseconds (exact stamps: t = 1 + k / 1000 computed

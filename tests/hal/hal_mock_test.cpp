@@ -13,17 +13,9 @@
 namespace pliant::hal {
 namespace {
 
+using test::event;
 using test::SteppedClock;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-FaultEvent event(FaultKind kind, double start_s, double duration_s, double value = kNaN) {
-  FaultEvent e;
-  e.kind = kind;
-  e.start_s = start_s;
-  e.duration_s = duration_s;
-  e.value = value;
-  return e;
-}
 
 struct GripperRig {
   SteppedClock t;

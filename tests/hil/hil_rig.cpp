@@ -59,9 +59,8 @@ SupervisorConfig hil_supervisor_config(const HilObject& object, const RigOptions
   g.cycle_timeout_s = 3 * period;
   g.clock_tolerance_s = 0.5 * period;
   g.wrench_frozen_samples = 1;
-  g.gripper_fault_mask = hal::kGripperFaultMask | hal::kStreamFaultMask;
-  g.wrench_fault_mask = hal::kFtFaultMask | hal::kStreamFaultMask;
-  g.camera_fault_mask = hal::kFrameFaultMask | hal::kStreamFaultMask;
+  // The fault masks stay the guard's defaults: each device's own fault bits plus the stream
+  // monitor's flags, which the rig ORs into every sample's status word.
   c.gripper_monitor.max_interval_s = 3 * period;
   c.wrench_monitor.max_interval_s = 3 * period;
   c.camera_monitor.max_interval_s = 3.0 / options.camera_rate_hz;

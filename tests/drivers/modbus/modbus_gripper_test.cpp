@@ -13,6 +13,7 @@
 
 #include "pliant/drivers/modbus/emulator/modbus_emulator.hpp"
 #include "pliant/drivers/modbus/robotiq_gripper.hpp"
+#include "pliant/hal/guard_inputs.hpp"
 
 namespace pliant::drivers::modbus {
 namespace {
@@ -245,6 +246,57 @@ TEST_F(RobotiqGripperTest, FaultCodeIsDecodedIntoStatusBits) {
   r = read_ok();
   EXPECT_EQ(r.header.status_bits & hal::kGripperFaultMask, 0u);
   EXPECT_EQ(gripper->counters().fault_samples, 2u);
+}
+
+// The guard's default gripper mask on a real Robotiq status word, read over Modbus TCP: every
+// state the 2F-85 passes through on the way to squeezing an object (reset, activating,
+// activated, moving, object detected, at target) is clear of it; every non-zero gFLT and kFLT
+// value is caught.
+TEST_F(RobotiqGripperTest, TheGuardsDefaultMaskTellsStatesFromFaults) {
+  const std::uint32_t mask = GraspGuardConfig{}.gripper_fault_mask;
+  const auto sample_bits = [this] {
+    hal::GripperReading r;
+    EXPECT_EQ(gripper->read(r), HalStatus::ok);
+    GripperSample sample;
+    hal::update_gripper_sample(HalStatus::ok, r, 0, sample);
+    return sample.status_bits;
+  };
+  emulator.set_object(0.05, 2000.0);
+  make();
+  ASSERT_EQ(gripper->configure(), HalStatus::ok);
+  ASSERT_EQ(gripper->start(), HalStatus::ok);
+  std::uint32_t seen = 0;
+  const auto expect_no_fault = [&](const char* state) {
+    const std::uint32_t bits = sample_bits();
+    seen |= bits;
+    EXPECT_EQ(bits & mask, 0u) << state << ": status " << bits;
+  };
+  expect_no_fault("reset");
+  tick(clock, config.reset_hold_s);
+  expect_no_fault("activating");
+  emulator.advance(0.5);
+  tick(clock, 0.05);
+  expect_no_fault("activated");
+  ASSERT_TRUE(gripper->activated());
+  ASSERT_EQ(gripper->move_to(0.0, 0.02, 60), HalStatus::ok);
+  emulator.advance(0.1);
+  expect_no_fault("moving");
+  emulator.advance(5.0);
+  expect_no_fault("object detected");
+  ASSERT_EQ(gripper->move_to(0.08, 0.1, 60), HalStatus::ok);
+  emulator.advance(5.0);
+  expect_no_fault("at target");
+  EXPECT_EQ(seen & 0x0fu,
+            hal::kGripperActivated | hal::kGripperMoving | hal::kGripperObjectDetected | hal::kGripperAtTarget);
+  for (int gflt = 0; gflt <= 0x0f; ++gflt) {
+    for (int kflt = 0; kflt <= 0x0f; kflt += 0x05) {
+      if (gflt == 0 && kflt == 0) continue;
+      emulator.set_gripper_fault(static_cast<std::uint8_t>(gflt | kflt << 4));
+      EXPECT_NE(sample_bits() & mask, 0u) << "gFLT " << gflt << " kFLT " << kflt;
+    }
+  }
+  emulator.set_gripper_fault(0x00);
+  EXPECT_EQ(sample_bits() & mask, 0u);
 }
 
 TEST_F(RobotiqGripperTest, FallsBackToFc03WhenFc04IsRefused) {

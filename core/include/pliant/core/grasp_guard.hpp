@@ -105,6 +105,23 @@ namespace pliant {
 
 enum class GraspVerdict : std::uint8_t { ok = 0, limit = 1, stop = 2 };
 
+// --- the status-word conventions behind the default fault masks ------------------------------------
+// The core cannot include hal/, so the bits are repeated here; hal/guard_inputs.hpp checks at
+// compile time that they equal the HAL's constants (docs/grasp_guard.md, "Status words").
+/// The stream monitor's "do not trust this sample" flags, bits 17-21 (hal/stream_monitor.hpp):
+/// stamp stall, backwards, jump, frozen payload, non-finite. Bit 16 (a sequence gap) only
+/// counts a drop and is not among them.
+inline constexpr std::uint32_t kGuardStreamFaultBits = 0x003e0000u;
+/// Gripper: the fault code byte, bits 8-15 (hal/gripper.hpp; a Robotiq's gFLT | kFLT << 4). Bits
+/// 0-3 (activated, moving, object detected, at target) are states, never faults.
+inline constexpr std::uint32_t kGuardGripperFaultBits = 0x0000ff00u;
+/// Wrench: the ATI NETCANOEM status bits that make a reading untrustworthy, 1-7, 11, 12
+/// (hal/force_torque.hpp); bit 0 (watchdog reset) and bit 14 (CAN transport degraded) are not.
+inline constexpr std::uint32_t kGuardWrenchFaultBits = 0x000018feu;
+/// Camera: the device marked the frame unusable (bit 0, hal/camera.hpp). A partial frame (bit 1:
+/// particles occluded, e.g. by the jaws) is normal during a grasp and is not a fault.
+inline constexpr std::uint32_t kGuardCameraFaultBits = 0x00000001u;
+
 enum class StopAction : std::uint8_t {
   freeze,  ///< stop all jaw motion; keep the current position command
   open,    ///< open to at least the contact width (release the squeeze)
@@ -184,11 +201,14 @@ struct GraspGuardConfig {
   int wrench_frozen_samples = 0;     ///< bit-identical wrench samples that mean frozen; 0: off
 
   // --- status words: set bits in the mask are faults -----------------------------------------------
-  std::uint32_t gripper_fault_mask = 0xffffffffu;
+  // The defaults follow the HAL's status words plus the stream monitor's flags (the constants
+  // above), right for every gripper, force/torque sensor and camera pliant's drivers read. A
+  // driver of your own maps its device's word onto the same bits, or sets its own masks here.
+  std::uint32_t gripper_fault_mask = kGuardGripperFaultBits | kGuardStreamFaultBits;
   /// ATI NETCANOEM status bits 1-7, 11, 12 (docs/drivers/socketcan.md); map other sensors'
   /// words to them.
-  std::uint32_t wrench_fault_mask = 0x18feu;
-  std::uint32_t camera_fault_mask = 0xffffffffu;
+  std::uint32_t wrench_fault_mask = kGuardWrenchFaultBits | kGuardStreamFaultBits;
+  std::uint32_t camera_fault_mask = kGuardCameraFaultBits | kGuardStreamFaultBits;
 
   // --- verdicts and hysteresis --------------------------------------------------------------------------
   /// Verdict of a fault per GuardSource (limit or stop; ok is refused at init).

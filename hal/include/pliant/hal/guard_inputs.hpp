@@ -23,8 +23,16 @@
 #include "pliant/hal/camera.hpp"
 #include "pliant/hal/force_torque.hpp"
 #include "pliant/hal/gripper.hpp"
+#include "pliant/hal/stream_monitor.hpp"
 
 namespace pliant::hal {
+
+// The guard's default fault masks are these HAL conventions (the core repeats the bits, since it
+// cannot include hal/): a change to either side must change both.
+static_assert(kGuardStreamFaultBits == kStreamFaultMask, "core's stream flags differ from the monitor's");
+static_assert(kGuardGripperFaultBits == kGripperFaultMask, "core's gripper fault bits differ from the HAL's");
+static_assert(kGuardWrenchFaultBits == kFtFaultMask, "core's wrench fault bits differ from the HAL's");
+static_assert(kGuardCameraFaultBits == kFrameFaultMask, "core's camera fault bits differ from the HAL's");
 
 void update_gripper_sample(HalStatus read_status, const GripperReading& reading, std::uint32_t monitor_flags,
                            GripperSample& sample) noexcept;
