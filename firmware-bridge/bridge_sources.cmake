@@ -39,4 +39,5 @@ else()
   set(PLIANT_PC_INCLUDEDIR "\${prefix}/${CMAKE_INSTALL_INCLUDEDIR}")
 endif()
 configure_file(${CMAKE_CURRENT_SOURCE_DIR}/pliant-bridge.pc.in ${CMAKE_CURRENT_BINARY_DIR}/pliant-bridge.pc @ONLY)
-install(FILES ${CMAKE_CURRENT_BINARY_DIR}/pliant-bridge.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+install(FILES ${CMAKE_CURRENT_BINARY_DIR}/pliant-bridge.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig
+  COMPONENT core_dev)

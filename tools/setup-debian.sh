@@ -6,6 +6,7 @@ set -euo pipefail
 packages=(
   cmake g++ make pkg-config      # build
   ninja-build ccache             # tools/test.sh: Ninja builds, every compile cached
+  dpkg-dev                       # tools/packages.sh: dpkg-shlibdeps reads the program's run-time Depends
   clang-format clang-tidy        # tools/lint.sh
   python3                        # tools/lint_tidy.py
   libeigen3-dev                  # core linear algebra (the only core dependency)

@@ -3,6 +3,8 @@
 #   setup      install what is missing (tools/setup-debian.sh)
 #   release    build everything (Release) and run every test: unit, integration, acceptance,
 #              install consumers
+#   package    tools/packages.sh: the Debian packages (CPack) from the release build, their
+#              dependencies resolved by apt, and the install consumer built against them unpacked
 #   sanitize   AddressSanitizer + UndefinedBehaviorSanitizer build of what parses outside input or
 #              runs real-time code (PLIANT_SANITIZE_SCOPE=input, see tests/CMakeLists.txt), and
 #              its tests except the slow acceptance runs
@@ -12,7 +14,8 @@
 #   lint       tools/lint.sh: formatting and static checks
 # Every build goes through ccache (installed by the set-up script, cache in ~/.cache/ccache), so a
 # rerun on the same machine recompiles only what changed.
-# Usage: bash tools/test.sh [STAGE ...]      (no argument: every stage, in the order above)
+# Usage: bash tools/test.sh [STAGE ...]      (no argument: every stage, in the order above;
+#                                            package needs the release stage's build)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD
@@ -67,6 +70,8 @@ sanitize() {
     ctest --test-dir build-asan -j"$jobs" --output-on-failure -LE acceptance -E install_consumer
 }
 
+package() { bash tools/packages.sh build; }
+
 cross() { bash tools/cross.sh; }
 
 fuzz() {
@@ -79,11 +84,11 @@ fuzz() {
 lint() { bash tools/lint.sh; }
 
 stages=("$@")
-[ ${#stages[@]} -gt 0 ] || stages=(setup release sanitize cross fuzz lint)
+[ ${#stages[@]} -gt 0 ] || stages=(setup release package sanitize cross fuzz lint)
 for stage in "${stages[@]}"; do
   case $stage in
-    setup | release | sanitize | cross | fuzz | lint) ;;
-    *) echo "usage: $0 [setup|release|sanitize|cross|fuzz|lint ...]" >&2; exit 2 ;;
+    setup | release | package | sanitize | cross | fuzz | lint) ;;
+    *) echo "usage: $0 [setup|release|package|sanitize|cross|fuzz|lint ...]" >&2; exit 2 ;;
   esac
 done
 
