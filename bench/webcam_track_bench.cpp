@@ -14,8 +14,16 @@
 // commit. Also timed: the same without the backward flow, and the whole pipeline (track_particles: decoding from
 // memory, grey conversion, the core tracker, roles).
 //
-//   webcam_track_bench [--frames N] [--quick]
+// The flow is computed over the particles' region (AdvectionConfig::flow_margin_px); a row with
+// the whole frame shows what that saves. --load runs a second process spinning on one core
+// throughout, and the verdict is then on wall time: the condition of >= 10 frames/s at 1920 x
+// 1080 "on two cores while another process loads one core".
+//
+//   webcam_track_bench [--frames N] [--quick] [--load]
+#include <signal.h>
+#include <sys/wait.h>
 #include <time.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cmath>
@@ -76,6 +84,31 @@ std::vector<cv::Point2d> grid_points(cv::Size size, double spacing) {
   return points;
 }
 
+// --load: a second process spinning on one core for the whole run (issue 20's condition for the
+// 1920 x 1080 target); it is killed when this object goes.
+class OneCoreLoad {
+ public:
+  explicit OneCoreLoad(bool on) {
+    if (!on) return;
+    pid_ = fork();
+    if (pid_ == 0) {
+      volatile unsigned long spin = 0;
+      for (;;) spin = spin + 1;
+    }
+    if (pid_ > 0) std::printf("load: process %d spins on one core\n", static_cast<int>(pid_));
+  }
+  ~OneCoreLoad() {
+    if (pid_ <= 0) return;
+    kill(pid_, SIGKILL);
+    waitpid(pid_, nullptr, 0);
+  }
+  OneCoreLoad(const OneCoreLoad&) = delete;
+  OneCoreLoad& operator=(const OneCoreLoad&) = delete;
+
+ private:
+  pid_t pid_ = -1;
+};
+
 struct Timing {
   double wall_ms = 0, cpu_ms = 0;
   double fps() const { return 1000.0 / wall_ms; }
@@ -83,12 +116,19 @@ struct Timing {
   double fps_two_cores() const { return 2000.0 / cpu_ms; }
 };
 
-Timing time_advection(const std::vector<cv::Mat>& frames, FlowMethod method, int finest_scale, bool forward_backward,
-                      double spacing, int refine_window_px = AdvectionConfig{}.refine_window_px) {
+AdvectionConfig settings(int finest_scale, bool forward_backward = true,
+                         int refine_window_px = AdvectionConfig{}.refine_window_px,
+                         int flow_margin_px = AdvectionConfig{}.flow_margin_px) {
   AdvectionConfig config;
   config.dis_finest_scale = finest_scale;
   config.forward_backward = forward_backward;
   config.refine_window_px = refine_window_px;
+  config.flow_margin_px = flow_margin_px;
+  return config;
+}
+
+Timing time_advection(const std::vector<cv::Mat>& frames, FlowMethod method, const AdvectionConfig& config,
+                      double spacing) {
   FlowAdvector advector(method, config);
   std::vector<cv::Point2d> positions = grid_points(frames[0].size(), spacing);
   advector.start(frames[0], positions);
@@ -145,17 +185,21 @@ void row(const char* size, const char* method, const std::string& detail, const 
 
 int main(int argc, char** argv) {
   int frames_640 = 61, frames_1080 = 31;
+  bool load = false;
   for (int i = 1; i < argc; ++i) {
-    if (std::strcmp(argv[i], "--quick") == 0) {
+    if (std::strcmp(argv[i], "--load") == 0) {
+      load = true;
+    } else if (std::strcmp(argv[i], "--quick") == 0) {
       frames_640 = 21;
       frames_1080 = 11;
     } else if (std::strcmp(argv[i], "--frames") == 0 && i + 1 < argc) {
       frames_640 = frames_1080 = std::max(3, std::atoi(argv[++i]));
     } else {
-      std::fprintf(stderr, "usage: webcam_track_bench [--frames N] [--quick]\n");
+      std::fprintf(stderr, "usage: webcam_track_bench [--frames N] [--quick] [--load]\n");
       return 2;
     }
   }
+  const OneCoreLoad busy(load);
   std::printf("webcam_track_bench (build type %s, OpenCV %s, %d OpenCV threads)\n", PLIANT_BENCH_BUILD_TYPE, CV_VERSION,
               cv::getNumThreads());
   std::printf(
@@ -178,26 +222,33 @@ int main(int argc, char** argv) {
     const std::vector<cv::Mat> frames = render_frames(c.size, c.frames);
     const int scale = dis_finest_scale_for_spacing(c.spacing);
     char target[64];
-    const Timing dis = time_advection(frames, FlowMethod::dis, scale, true, c.spacing);
-    const bool met = dis.fps_two_cores() >= c.target_fps;
+    const Timing dis = time_advection(frames, FlowMethod::dis, settings(scale), c.spacing);
+    // Under --load the other process holds one core: the target is then wall time.
+    const bool met = (load ? dis.fps() : dis.fps_two_cores()) >= c.target_fps;
     all_met = all_met && met;
     std::snprintf(target, sizeof target, ">= %.0f fps: %s", c.target_fps, met ? "met" : "MISSED");
+    const std::string margin = std::to_string(AdvectionConfig{}.flow_margin_px);
     row(c.name, "dis",
         "scale " + std::to_string(scale) + " (spacing " + std::to_string(static_cast<int>(c.spacing)) +
-            " px), fb check",
+            " px), fb check, margin " + margin,
         dis, target);
+    row(c.name, "dis", "scale " + std::to_string(scale) + ", fb check, whole frame",
+        time_advection(frames, FlowMethod::dis, settings(scale, true, AdvectionConfig{}.refine_window_px, -1),
+                       c.spacing),
+        "");
     row(c.name, "dis", "scale 1 (spacing < 64 px), fb check",
-        time_advection(frames, FlowMethod::dis, 1, true, c.spacing), "");
+        time_advection(frames, FlowMethod::dis, settings(1), c.spacing), "");
     row(c.name, "dis", "scale " + std::to_string(scale) + ", no fb check",
-        time_advection(frames, FlowMethod::dis, scale, false, c.spacing), "");
+        time_advection(frames, FlowMethod::dis, settings(scale, false), c.spacing), "");
     row(c.name, "dis", "scale " + std::to_string(scale) + ", fb check, no LK refinement",
-        time_advection(frames, FlowMethod::dis, scale, true, c.spacing, 0), "");
+        time_advection(frames, FlowMethod::dis, settings(scale, true, 0), c.spacing), "");
     row(c.name, "farneback", "fb check (reference)",
         time_advection(std::vector<cv::Mat>(frames.begin(), frames.begin() + std::min<int>(c.frames, 11)),
-                       FlowMethod::farneback, 2, true, c.spacing),
+                       FlowMethod::farneback, settings(2), c.spacing),
         "");
     row(c.name, "dis", "whole pipeline (track_particles)", time_pipeline(frames, c.spacing), "");
   }
-  std::printf("\n%s\n", all_met ? "DIS targets met (CPU time)." : "DIS targets MISSED (CPU time).");
+  const char* basis = load ? "wall time, one core loaded" : "CPU time";
+  std::printf("\nDIS targets %s (%s).\n", all_met ? "met" : "MISSED", basis);
   return 0;
 }

@@ -71,6 +71,10 @@ TrackCommand::TrackCommand(CLI::App& parent) {
                    "Lucas-Kanade window that refines each advected particle at full resolution, px (0: off)")
       ->type_name("PX")
       ->capture_default_str();
+  app_->add_option("--flow-margin", flow_margin_px_,
+                   "Dense flow only within this many pixels of the particles (-1: the whole frame)")
+      ->type_name("PX")
+      ->capture_default_str();
   app_->add_option("--fb-threshold", fb_threshold_px_, "Largest forward-backward flow error of an observation, px")
       ->type_name("PX")
       ->capture_default_str();
@@ -102,6 +106,7 @@ int TrackCommand::run() const {
     options.flow = webcam::parse_flow_method(flow_);
     options.advection.window_px = window_px_;
     options.advection.refine_window_px = refine_window_px_;
+    options.advection.flow_margin_px = flow_margin_px_;
     options.advection.fb_threshold_px = fb_threshold_px_;
     options.advection.min_similarity = min_similarity_;
     options.advection.refresh_similarity = std::max(options.advection.refresh_similarity, min_similarity_);

@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli_registry.hpp"
+#include "pliant/vision/webcam_advection.hpp"
 
 namespace pliant::cli {
 
@@ -33,6 +34,7 @@ class TrackCommand final : public OptionalCommand {
   double fps_hz_ = 0;
   int window_px_ = 10;
   int refine_window_px_ = 9;
+  int flow_margin_px_ = vision::webcam::AdvectionConfig{}.flow_margin_px;
   double fb_threshold_px_ = 1.0;
   double min_similarity_ = 0.8;
   double track_beta_ = 0.5;

@@ -184,6 +184,8 @@ TEST(webcam_cli, MalformedInputIsRefusedAndWritesNothing) {
                  dir.path());
   expect_refused(run_pliant("track " + quoted(p.pattern()) + region + " --flow lk" + out), "--flow: expected",
                  dir.path());
+  expect_refused(run_pliant("track " + quoted(p.pattern()) + region + " --flow-margin 8" + out),
+                 "--flow-margin must be 16..4096 px, or -1", dir.path());
   expect_refused(run_pliant("track " + quoted(p.pattern()) + region + " --fps 10 --rate 20" + out),
                  "--rate 20 Hz is above the source's 10", dir.path());
   expect_refused(run_pliant("track " + quoted(p.pattern()) + region + " --support 1,x" + out), "--support: expected",

@@ -2,8 +2,11 @@
 // checks on synthetic frames whose motion is known.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
+
+#include <opencv2/imgproc.hpp>
 
 #include "pliant/vision/webcam_advection.hpp"
 #include "pliant/vision/webcam_error.hpp"
@@ -127,7 +130,16 @@ TEST(webcam_flow, MethodNamesAndSettings) {
     bad.refine_window_px = refine;
     EXPECT_THROW(check_advection_config(bad), InputError) << refine;
   }
+  for (int margin : {-2, 0, 15, 4097}) {
+    bad = AdvectionConfig{};
+    bad.flow_margin_px = margin;
+    EXPECT_THROW(check_advection_config(bad), InputError) << margin;
+  }
   AdvectionConfig good;
+  for (int margin : {-1, 16, 4096}) {
+    good.flow_margin_px = margin;
+    EXPECT_NO_THROW(check_advection_config(good)) << margin;
+  }
   for (int refine : {0, 3, 9, 51}) {
     good.refine_window_px = refine;
     EXPECT_NO_THROW(check_advection_config(good)) << refine;
@@ -174,8 +186,52 @@ TEST(webcam_flow, AdvectorObservesMovingParticlesAndNotCoveredOnes) {
     }
     advector.commit(positions, seen);
   }
-  EXPECT_EQ(advector.forward_flow().size(), texture.size());
-  EXPECT_EQ(advector.backward_flow().size(), texture.size());
+  EXPECT_EQ(advector.forward_flow().size(), advector.flow_region().size());
+  EXPECT_EQ(advector.backward_flow().size(), advector.flow_region().size());
+  EXPECT_EQ(advector.flow_region() & cv::Rect(cv::Point(0, 0), texture.size()), advector.flow_region());
+}
+
+// The flow region: the particles' bounding box grown by the margin, clipped to the frame; on a
+// texture that moves and turns, particles advected in it land where the whole frame's flow
+// puts them, to well under the tracking error.
+TEST(webcam_flow, TheFlowRegionFollowsTheParticlesAndAdvectsAsTheWholeFrame) {
+  const cv::Mat texture = test::random_texture(960, 540, 21);
+  std::vector<cv::Point2d> start;
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 8; ++c) start.emplace_back(330 + 40.0 * c, 200 + 40.0 * r);
+  }
+  AdvectionConfig roi;
+  roi.flow_margin_px = 48;
+  AdvectionConfig whole = roi;
+  whole.flow_margin_px = -1;
+  FlowAdvector in_region(FlowMethod::dis, roi), in_frame(FlowMethod::dis, whole);
+  in_region.start(texture, start);
+  in_frame.start(texture, start);
+  std::vector<cv::Point2d> a = start, b = start;
+  const std::vector<std::uint8_t> seen(start.size(), 1);
+  std::vector<ParticleObservation> out_a, out_b;
+  const cv::Point2f centre(480, 270);
+  double worst = 0;
+  for (int k = 1; k <= 6; ++k) {
+    cv::Mat frame;
+    const cv::Mat m = cv::getRotationMatrix2D(centre, 0.4 * k, 1.0 + 0.004 * k);
+    cv::warpAffine(texture, frame, m, texture.size(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+    in_region.observe(frame, a, a, seen, out_a);
+    in_frame.observe(frame, b, b, seen, out_b);
+    for (std::size_t i = 0; i < start.size(); ++i) {
+      ASSERT_TRUE(out_a[i].usable() && out_b[i].usable()) << k << " " << i;
+      worst = std::max(worst, cv::norm(out_a[i].position - out_b[i].position));
+      a[i] = out_a[i].position;
+      b[i] = out_b[i].position;
+    }
+    in_region.commit(a, seen);
+    in_frame.commit(b, seen);
+    const cv::Rect& region = in_region.flow_region();
+    EXPECT_LE(region.x, 330 - 48 + 8);
+    EXPECT_LT(region.area(), texture.size().area() / 2) << k;
+    EXPECT_EQ(in_frame.flow_region(), cv::Rect(cv::Point(0, 0), texture.size()));
+  }
+  EXPECT_LT(worst, 0.05);
 }
 
 }  // namespace

@@ -1,4 +1,5 @@
 // Advection, forward-backward and appearance checks, and the search for hidden particles.
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -13,6 +14,31 @@ namespace {
 bool inside(const cv::Mat& frame, const cv::Point2d& p) {
   return std::isfinite(p.x) && std::isfinite(p.y) && p.x >= -0.5 && p.y >= -0.5 && p.x <= frame.cols - 0.5 &&
          p.y <= frame.rows - 0.5;
+}
+
+// The bounding box of the finite points of `a` and `b` grown by margin_px and clipped to `frame`;
+// the whole frame when margin_px < 0 or no point is finite.
+cv::Rect region_around(const std::vector<cv::Point2d>& a, const std::vector<cv::Point2d>& b, int margin_px,
+                       cv::Size frame) {
+  const cv::Rect whole(cv::Point(0, 0), frame);
+  if (margin_px < 0) return whole;
+  double x0 = HUGE_VAL, y0 = HUGE_VAL, x1 = -HUGE_VAL, y1 = -HUGE_VAL;
+  for (const std::vector<cv::Point2d>* points : {&a, &b}) {
+    for (const cv::Point2d& p : *points) {
+      if (!std::isfinite(p.x) || !std::isfinite(p.y)) continue;
+      x0 = std::min(x0, p.x);
+      y0 = std::min(y0, p.y);
+      x1 = std::max(x1, p.x);
+      y1 = std::max(y1, p.y);
+    }
+  }
+  if (!(x0 <= x1 && y0 <= y1)) return whole;
+  const double m = margin_px;
+  const auto clamp = [](double v, int hi) { return static_cast<int>(std::clamp(v, 0.0, static_cast<double>(hi))); };
+  const cv::Point top_left(clamp(std::floor(x0 - m), frame.width), clamp(std::floor(y0 - m), frame.height));
+  const cv::Point bottom_right(clamp(std::ceil(x1 + m) + 1, frame.width), clamp(std::ceil(y1 + m) + 1, frame.height));
+  const cv::Rect region(top_left, bottom_right);
+  return region.area() > 0 ? region : whole;
 }
 
 }  // namespace
@@ -46,6 +72,9 @@ void check_advection_config(const AdvectionConfig& c) {
   }
   if (c.dis_finest_scale < -1 || c.dis_finest_scale > 4)
     throw InputError("DIS finest scale must be 0..4 (or -1: from the spacing)");
+  if (c.flow_margin_px != -1 && (c.flow_margin_px < 16 || c.flow_margin_px > 4096)) {
+    throw InputError("--flow-margin must be 16..4096 px, or -1 (the whole frame)");
+  }
 }
 
 FlowAdvector::FlowAdvector(FlowMethod method, const AdvectionConfig& config)
@@ -81,17 +110,19 @@ void FlowAdvector::observe(const cv::Mat& next, const std::vector<cv::Point2d>& 
   CV_Assert(next.type() == CV_8UC1 && next.size() == previous_.size() && positions.size() == n &&
             predicted.size() == n && seen.size() == n);
   next.copyTo(next_);
-  flow_.compute(previous_, next_, forward_);
+  region_ = region_around(positions, predicted, config_.flow_margin_px, previous_.size());
+  previous_(region_).copyTo(previous_region_);  // DIS needs continuous images
+  next_(region_).copyTo(next_region_);
+  flow_.compute(previous_region_, next_region_, forward_);
   if (config_.forward_backward) {
-    flow_.compute(next_, previous_, backward_);
+    flow_.compute(next_region_, previous_region_, backward_);
   } else {
     backward_.release();
   }
   out.assign(n, ParticleObservation{});
   advected_.assign(n, cv::Point2d(ParticleObservation::kNaN, ParticleObservation::kNaN));
   for (std::size_t i = 0; i < n; ++i) {
-    if (inside(previous_, positions[i]))
-      advected_[i] = positions[i] + window_mean_flow(forward_, positions[i], config_.window_px);
+    if (inside(previous_, positions[i])) advected_[i] = positions[i] + mean_flow(forward_, positions[i]);
   }
   if (config_.refine_window_px > 0) refine(positions);
   for (std::size_t i = 0; i < n; ++i) {
@@ -110,7 +141,7 @@ void FlowAdvector::observe(const cv::Mat& next, const std::vector<cv::Point2d>& 
         continue;
       }
       if (config_.forward_backward) {
-        const cv::Point2d back = q + window_mean_flow(backward_, q, config_.window_px);
+        const cv::Point2d back = q + mean_flow(backward_, q);
         o.fb_error_px = std::hypot(back.x - p.x, back.y - p.y);
       }
       extract_patch(next_, q, config_.patch_px, patch_);
@@ -136,6 +167,11 @@ void FlowAdvector::observe(const cv::Mat& next, const std::vector<cv::Point2d>& 
   }
   last_similarity_.resize(n);
   for (std::size_t i = 0; i < n; ++i) last_similarity_[i] = out[i].similarity;
+}
+
+cv::Point2d FlowAdvector::mean_flow(const cv::Mat& flow, const cv::Point2d& p) const {
+  const cv::Point2d corner(region_.x, region_.y);
+  return window_mean_flow(flow, p - corner, config_.window_px);
 }
 
 void FlowAdvector::refine(const std::vector<cv::Point2d>& positions) {
