@@ -209,6 +209,27 @@ struct Openni2Camera::Impl {
   HalStatus adopt_depth_mode(const std::string& uri, std::string& error);
   HalStatus choose_intrinsics(const DepthIntrinsics& fallback, std::string& error);
 
+  // Read steps (on_read runs them in this order).
+  /// Waits for the next frame as the mode allows (see the header) and reads it into `frame`: ok;
+  /// no_data when none came (a recording that is over or stalled ends its stream here); io_error.
+  HalStatus wait_for_frame(const hal::Clock& clock) noexcept;
+  /// Copies `frame` into `image` when it has the configured size and format; releases it.
+  bool copy_frame() noexcept;
+  /// The HAL sequence number of frame `index`: index minus the base, kept increasing when the
+  /// device's index restarts (counted in index_resets).
+  std::uint64_t sequence_of(int index) noexcept;
+  /// The frame's stamp on the HAL clock (now_s read after the frame arrived): stepped, the
+  /// recording's timeline from the first start, pauses added; live, the device stamp plus the
+  /// smallest clock offset seen.
+  double stamp_of(std::uint64_t ts_us, double now_s) noexcept;
+  /// The HAL frame over `image`.
+  void fill(double stamp_s, hal::DepthFrame& out) const noexcept;
+  void end_stream(bool early) noexcept {
+    stats.end_of_stream = true;
+    stats.ended_early = early;
+    stop_stream();
+  }
+
   void stop_stream() noexcept {
     if (!stream_running) return;
     stream.stop();
@@ -475,6 +496,96 @@ HalStatus Openni2Camera::on_cleanup() noexcept {
   return HalStatus::ok;
 }
 
+HalStatus Openni2Camera::Impl::wait_for_frame(const hal::Clock& clock) noexcept {
+  // Read the end-of-file flag before looking for a frame: the player raises it only after
+  // handing over its last frame, so "flag set and nothing pending" means nothing will come.
+  const bool end_of_file = recording && events->end_of_file();
+  openni::VideoStream* streams[1] = {&stream};
+  int ready = -1;
+  int timeout_ms = 0;
+  if (stepped && !end_of_file) {
+    // Block for what is left of step_timeout_s on the injected Clock, but never longer than
+    // step_timeout_s of real time: a ManualClock does not move while we block, so its caller
+    // sees no_data and advances it (header). The extra millisecond lets a real clock pass the
+    // deadline within this read despite the millisecond rounding of the wait.
+    const double now_s = clock.now_s();
+    if (!step_waiting) {
+      step_waiting = true;
+      step_wait_since_s = now_s;
+    }
+    const double left_s = std::min(step_wait_since_s + step_timeout_s - now_s, step_timeout_s);
+    if (left_s > 0) timeout_ms = static_cast<int>(std::ceil(left_s * 1000)) + 1;
+  }
+  const openni::Status waited = openni::OpenNI::waitForAnyStream(streams, 1, &ready, timeout_ms);
+  if (waited == openni::STATUS_TIME_OUT) {
+    if (recording) {
+      const double after_s = clock.now_s();
+      const bool timed_out =
+          stepped ? after_s - step_wait_since_s >= step_timeout_s : after_s - last_progress_s > stall_timeout_s;
+      if (end_of_file || timed_out) end_stream(stats.last_frame_index < static_cast<int>(last_frame_number));
+    }
+    return HalStatus::no_data;
+  }
+  if (waited != openni::STATUS_OK) return HalStatus::io_error;
+  if (stream.readFrame(&frame) != openni::STATUS_OK || !frame.isValid()) return HalStatus::io_error;
+  return HalStatus::ok;
+}
+
+bool Openni2Camera::Impl::copy_frame() noexcept {
+  const openni::VideoMode mode = frame.getVideoMode();
+  const bool copied =
+      frame.getWidth() == width && frame.getHeight() == height && mode.getPixelFormat() == format &&
+      frame.getStrideInBytes() > 0 && frame.getDataSize() > 0 &&
+      copy_depth_image(static_cast<const std::uint8_t*>(frame.getData()), static_cast<std::size_t>(frame.getDataSize()),
+                       width, height, static_cast<std::size_t>(frame.getStrideInBytes()), image.data(), image.size());
+  frame.release();
+  return copied;
+}
+
+std::uint64_t Openni2Camera::Impl::sequence_of(int index) noexcept {
+  if (!have_index) {
+    index_base = recording ? 0 : static_cast<std::int64_t>(index) - 1;
+    have_index = true;
+  }
+  std::int64_t sequence = static_cast<std::int64_t>(index) - index_base;
+  if (sequence <= static_cast<std::int64_t>(last_sequence)) {
+    ++stats.index_resets;
+    sequence = static_cast<std::int64_t>(last_sequence) + 1;
+    index_base = static_cast<std::int64_t>(index) - sequence;
+  }
+  return static_cast<std::uint64_t>(sequence);
+}
+
+double Openni2Camera::Impl::stamp_of(std::uint64_t ts_us, double now_s) noexcept {
+  const double ts_s = static_cast<double>(ts_us) * 1e-6;
+  if (stepped) {
+    if (!have_first_ts) {
+      first_ts_us = ts_us;
+      have_first_ts = true;
+    }
+    return anchor_s + paused_s + (ts_s - static_cast<double>(first_ts_us) * 1e-6);
+  }
+  const double observed = now_s - ts_s;
+  if (!have_offset || observed < offset_s) offset_s = observed;
+  have_offset = true;
+  return ts_s + offset_s;
+}
+
+void Openni2Camera::Impl::fill(double stamp_s, hal::DepthFrame& out) const noexcept {
+  out.header.stamp_s = stamp_s;
+  out.header.sequence = last_sequence;
+  out.header.status_bits = 0;
+  out.width = width;
+  out.height = height;
+  out.stride_bytes = 2 * width;
+  out.depth_scale_m = depth_scale_m;
+  out.data = image.data();
+  out.fx = intrinsics.fx;
+  out.fy = intrinsics.fy;
+  out.cx = intrinsics.cx;
+  out.cy = intrinsics.cy;
+}
+
 HalStatus Openni2Camera::on_read(hal::DepthFrame& out) noexcept {
   Impl& m = *impl_;
   if (m.stats.device_lost) return HalStatus::disconnected;
@@ -484,108 +595,27 @@ HalStatus Openni2Camera::on_read(hal::DepthFrame& out) noexcept {
   }
   if (m.stats.end_of_stream || !m.stream_running) return HalStatus::no_data;
 
-  const auto end_stream = [&m](bool early) {
-    m.stats.end_of_stream = true;
-    m.stats.ended_early = early;
-    m.stop_stream();
-  };
-  // Read the end-of-file flag before looking for a frame: the player raises it only after
-  // handing over its last frame, so "flag set and nothing pending" means nothing will come.
-  const bool end_of_file = m.recording && m.events->end_of_file();
-  openni::VideoStream* streams[1] = {&m.stream};
-  int ready = -1;
-  int timeout_ms = 0;
-  if (m.stepped && !end_of_file) {
-    // Block for what is left of step_timeout_s on the injected Clock, but never longer than
-    // step_timeout_s of real time: a ManualClock does not move while we block, so its caller
-    // sees no_data and advances it (header). The extra millisecond lets a real clock pass the
-    // deadline within this read despite the millisecond rounding of the wait.
-    const double now_s = clock_.now_s();
-    if (!m.step_waiting) {
-      m.step_waiting = true;
-      m.step_wait_since_s = now_s;
-    }
-    const double left_s = std::min(m.step_wait_since_s + m.step_timeout_s - now_s, m.step_timeout_s);
-    if (left_s > 0) timeout_ms = static_cast<int>(std::ceil(left_s * 1000)) + 1;
-  }
-  const openni::Status waited = openni::OpenNI::waitForAnyStream(streams, 1, &ready, timeout_ms);
-  if (waited == openni::STATUS_TIME_OUT) {
-    if (m.recording) {
-      const double now_s = clock_.now_s();
-      const bool timed_out =
-          m.stepped ? now_s - m.step_wait_since_s >= m.step_timeout_s : now_s - m.last_progress_s > m.stall_timeout_s;
-      if (end_of_file || timed_out) end_stream(m.stats.last_frame_index < static_cast<int>(m.last_frame_number));
-    }
-    return HalStatus::no_data;
-  }
-  if (waited != openni::STATUS_OK) return HalStatus::io_error;
-  if (m.stream.readFrame(&m.frame) != openni::STATUS_OK || !m.frame.isValid()) return HalStatus::io_error;
+  const HalStatus waited = m.wait_for_frame(clock_);
+  if (waited != HalStatus::ok) return waited;
   ++m.stats.received;
   m.last_progress_s = clock_.now_s();
   m.step_waiting = false;
 
   const int index = m.frame.getFrameIndex();
   const std::uint64_t ts_us = m.frame.getTimestamp();
-  const openni::VideoMode mode = m.frame.getVideoMode();
-  const bool copied =
-      m.frame.getWidth() == m.width && m.frame.getHeight() == m.height && mode.getPixelFormat() == m.format &&
-      m.frame.getStrideInBytes() > 0 && m.frame.getDataSize() > 0 &&
-      copy_depth_image(static_cast<const std::uint8_t*>(m.frame.getData()),
-                       static_cast<std::size_t>(m.frame.getDataSize()), m.width, m.height,
-                       static_cast<std::size_t>(m.frame.getStrideInBytes()), m.image.data(), m.image.size());
-  m.frame.release();
+  const bool copied = m.copy_frame();
   // The last frame of a recording: stop the stream now (the player would spin on the file end).
   const bool last = m.recording && index >= 0 && static_cast<std::uint32_t>(index) >= m.last_frame_number;
   if (!copied) {
     ++m.stats.rejected;
-    if (last) end_stream(true);
+    if (last) m.end_stream(true);
     return HalStatus::no_data;
   }
-
-  // Sequence number from the frame index (see the header).
-  if (!m.have_index) {
-    m.index_base = m.recording ? 0 : static_cast<std::int64_t>(index) - 1;
-    m.have_index = true;
-  }
-  std::int64_t sequence = static_cast<std::int64_t>(index) - m.index_base;
-  if (sequence <= static_cast<std::int64_t>(m.last_sequence)) {
-    ++m.stats.index_resets;
-    sequence = static_cast<std::int64_t>(m.last_sequence) + 1;
-    m.index_base = static_cast<std::int64_t>(index) - sequence;
-  }
-  m.last_sequence = static_cast<std::uint64_t>(sequence);
-
-  // Stamp on the HAL clock (see the header).
-  const double ts_s = static_cast<double>(ts_us) * 1e-6;
-  double stamp_s = 0;
-  if (m.stepped) {
-    if (!m.have_first_ts) {
-      m.first_ts_us = ts_us;
-      m.have_first_ts = true;
-    }
-    stamp_s = m.anchor_s + m.paused_s + (ts_s - static_cast<double>(m.first_ts_us) * 1e-6);
-  } else {
-    const double observed = clock_.now_s() - ts_s;
-    if (!m.have_offset || observed < m.offset_s) m.offset_s = observed;
-    m.have_offset = true;
-    stamp_s = ts_s + m.offset_s;
-  }
-
+  m.last_sequence = m.sequence_of(index);
   m.stats.last_frame_index = index;
   m.stats.last_timestamp_us = ts_us;
-  out.header.stamp_s = stamp_s;
-  out.header.sequence = m.last_sequence;
-  out.header.status_bits = 0;
-  out.width = m.width;
-  out.height = m.height;
-  out.stride_bytes = 2 * m.width;
-  out.depth_scale_m = m.depth_scale_m;
-  out.data = m.image.data();
-  out.fx = m.intrinsics.fx;
-  out.fy = m.intrinsics.fy;
-  out.cx = m.intrinsics.cx;
-  out.cy = m.intrinsics.cy;
-  if (last) end_stream(false);
+  m.fill(m.stamp_of(ts_us, clock_.now_s()), out);
+  if (last) m.end_stream(false);
   return HalStatus::ok;
 }
 
