@@ -5,7 +5,7 @@
 namespace pliant::hil {
 
 hal::HalStatus RecordingForceTorque::on_read(hal::WrenchReading& out) noexcept {
-  const hal::HalStatus s = sensor_.read(out);
+  const hal::HalStatus s = inner_.read(out);
   if (s == hal::HalStatus::ok) {
     last_ = out;
     has_reading_ = true;
@@ -14,7 +14,7 @@ hal::HalStatus RecordingForceTorque::on_read(hal::WrenchReading& out) noexcept {
 }
 
 hal::HalStatus FingerForceGripper::on_read(hal::GripperReading& out) noexcept {
-  const hal::HalStatus s = gripper_.read(out);
+  const hal::HalStatus s = inner_.read(out);
   if (s == hal::HalStatus::ok) {
     out.force_n = finger_.has_reading() ? finger_.last().wrench[axis_] : std::numeric_limits<double>::quiet_NaN();
   }

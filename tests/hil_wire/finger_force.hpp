@@ -18,43 +18,46 @@
 
 namespace pliant::hil {
 
-class RecordingForceTorque final : public hal::ForceTorqueSensor {
+/// A HAL device of kind Base that wraps another of the same kind: the lifecycle is forwarded.
+template <typename Base>
+class Decorator : public Base {
+ protected:
+  explicit Decorator(Base& inner) noexcept : inner_(inner) {}
+  hal::HalStatus on_configure() override { return inner_.configure(); }
+  hal::HalStatus on_start() noexcept override { return inner_.start(); }
+  hal::HalStatus on_stop() noexcept override { return inner_.stop(); }
+  hal::HalStatus on_cleanup() noexcept override { return inner_.cleanup(); }
+
+  Base& inner_;
+};
+
+class RecordingForceTorque final : public Decorator<hal::ForceTorqueSensor> {
  public:
-  explicit RecordingForceTorque(hal::ForceTorqueSensor& sensor) noexcept : sensor_(sensor) {}
+  explicit RecordingForceTorque(hal::ForceTorqueSensor& sensor) noexcept : Decorator(sensor) {}
   /// The last reading delivered (has_reading() false before the first).
   const hal::WrenchReading& last() const noexcept { return last_; }
   bool has_reading() const noexcept { return has_reading_; }
 
  protected:
-  hal::HalStatus on_configure() override { return sensor_.configure(); }
-  hal::HalStatus on_start() noexcept override { return sensor_.start(); }
-  hal::HalStatus on_stop() noexcept override { return sensor_.stop(); }
-  hal::HalStatus on_cleanup() noexcept override { return sensor_.cleanup(); }
   hal::HalStatus on_read(hal::WrenchReading& out) noexcept override;
 
  private:
-  hal::ForceTorqueSensor& sensor_;
   hal::WrenchReading last_;
   bool has_reading_ = false;
 };
 
-class FingerForceGripper final : public hal::Gripper {
+class FingerForceGripper final : public Decorator<hal::Gripper> {
  public:
   /// `axis`: 0..2, the sensor's force axis along the squeeze.
   FingerForceGripper(hal::Gripper& gripper, const RecordingForceTorque& finger, int axis) noexcept
-      : gripper_(gripper), finger_(finger), axis_(axis) {}
-  hal::GripperLimits limits() const noexcept override { return gripper_.limits(); }
+      : Decorator(gripper), finger_(finger), axis_(axis) {}
+  hal::GripperLimits limits() const noexcept override { return inner_.limits(); }
 
  protected:
-  hal::HalStatus on_configure() override { return gripper_.configure(); }
-  hal::HalStatus on_start() noexcept override { return gripper_.start(); }
-  hal::HalStatus on_stop() noexcept override { return gripper_.stop(); }
-  hal::HalStatus on_cleanup() noexcept override { return gripper_.cleanup(); }
   hal::HalStatus on_read(hal::GripperReading& out) noexcept override;
-  hal::HalStatus on_write(const hal::GripperCommand& command) noexcept override { return gripper_.write(command); }
+  hal::HalStatus on_write(const hal::GripperCommand& command) noexcept override { return inner_.write(command); }
 
  private:
-  hal::Gripper& gripper_;
   const RecordingForceTorque& finger_;
   int axis_;
 };

@@ -32,8 +32,8 @@ FingerGauges::FingerGauges(const ati::Calibration& calibration, double noise_cou
   inverse_ = m.inverse();
   for (int k = 0; k < 3; ++k) {
     counts_[k] = static_cast<double>(calibration.counts_per_force) / ati::force_unit_to_newton(calibration.force_unit);
-    counts_[k + 3] = static_cast<double>(calibration.counts_per_torque) /
-                     ati::torque_unit_to_newton_metre(calibration.torque_unit);
+    counts_[k + 3] =
+        static_cast<double>(calibration.counts_per_torque) / ati::torque_unit_to_newton_metre(calibration.torque_unit);
   }
 }
 

@@ -75,9 +75,10 @@ TEST(HilWire, SoftToStiffObjectsStopBeforeTheirLimit) {
     worst = std::max(worst, overshoot);
     std::printf("%-16s %5.2f %6.3f %8.4f %8.4f %8.1f%% %-18s %-6s/%-9s %6ld %6ld %7llu %7llu\n", object.name.c_str(),
                 object.object.msm_beta, object.max_strain, g.strain_at_stop, g.peak, 100 * overshoot,
-                g.stopped_by_verdict ? guard_reason_name(g.first_reason) : "safe width", grasp_verdict_name(g.final_verdict),
-                guard_reason_name(g.final_reason), g.first_stop >= 0 && g.contact >= 0 ? g.first_stop - g.contact : -1L,
-                g.cycles, static_cast<unsigned long long>(rig.gripper->link_counters().transactions),
+                g.stopped_by_verdict ? guard_reason_name(g.first_reason) : "safe width",
+                grasp_verdict_name(g.final_verdict), guard_reason_name(g.final_reason),
+                g.first_stop >= 0 && g.contact >= 0 ? g.first_stop - g.contact : -1L, g.cycles,
+                static_cast<unsigned long long>(rig.gripper->link_counters().transactions),
                 static_cast<unsigned long long>(rig.sensor->link_counters().frames_received));
     ASSERT_GE(g.contact, 0) << "never touched the object";
     ASSERT_GE(g.first_stop, 0) << "the guard never stopped the squeeze";
@@ -178,7 +179,8 @@ TEST(HilWire, EveryWireFaultIsNotOkWithinTwoCyclesAndRecovers) {
     for (std::size_t k = 0; k < faults.size(); ++k) {
       for (double fraction : fractions) {
         SCOPED_TRACE(object.name + " / " + faults[k].name + " at " + std::to_string(fraction));
-        const long at = base.contact + static_cast<long>(fraction * static_cast<double>(base.first_stop - base.contact));
+        const long at =
+            base.contact + static_cast<long>(fraction * static_cast<double>(base.first_stop - base.contact));
         const FaultRun r = run_fault(object, options, faults[k], at);
         ASSERT_GE(r.onset, 0) << "the fault never reached the supervisor";
         EXPECT_TRUE(r.ok_before) << "the verdict was not ok before the fault: the latency would mean nothing";
@@ -199,9 +201,10 @@ TEST(HilWire, EveryWireFaultIsNotOkWithinTwoCyclesAndRecovers) {
       }
     }
   }
-  std::printf("\nWire HIL faults (%zu objects x %zu onsets; latency = cycles from onset to not ok; recovery = cycles "
-              "from the fault clearing to no fault)\n",
-              objects.size(), fractions.size());
+  std::printf(
+      "\nWire HIL faults (%zu objects x %zu onsets; latency = cycles from onset to not ok; recovery = cycles "
+      "from the fault clearing to no fault)\n",
+      objects.size(), fractions.size());
   std::printf("%-24s %-8s %-22s %4s %7s %7s %8s  %s\n", "fault", "device", "injected", "runs", "latency", "counted",
               "recovery", "verdict / reason");
   for (std::size_t k = 0; k < faults.size(); ++k) {

@@ -39,9 +39,8 @@ const char* wire_device_name(WireDevice device) noexcept {
 
 std::vector<WireFault> wire_faults() {
   return {
-      {"Modbus timeout", WireDevice::gripper, "drop_replies(3)",
-       [](WireRig& r) { r.gripper_emulator.drop_replies(3); }, nullptr,
-       [](const WireRig& r) { return r.gripper->link_counters().timeouts; }, nullptr},
+      {"Modbus timeout", WireDevice::gripper, "drop_replies(3)", [](WireRig& r) { r.gripper_emulator.drop_replies(3); },
+       nullptr, [](const WireRig& r) { return r.gripper->link_counters().timeouts; }, nullptr},
       {"Modbus exception", WireDevice::gripper, "fc04 -> exception 1",
        [](WireRig& r) { r.gripper_emulator.set_fc04_supported(false); },
        [](WireRig& r) { r.gripper_emulator.set_fc04_supported(true); },
@@ -75,9 +74,9 @@ std::vector<WireFault> wire_faults() {
        [](WireRig& r) { r.sensor_emulator->faults().mute = true; },
        [](WireRig& r) { r.sensor_emulator->faults().mute = false; },
        [](const WireRig& r) { return r.sensor->counters().no_data; }, nullptr},
-      {"frozen gauges", WireDevice::sensor, "gauges not updated",
-       [](WireRig& r) { r.freeze_gauges(true); }, [](WireRig& r) { r.freeze_gauges(false); },
-       [](const WireRig& r) { return guard_stale(r, GuardSource::wrench); }, nullptr},
+      {"frozen gauges", WireDevice::sensor, "gauges not updated", [](WireRig& r) { r.freeze_gauges(true); },
+       [](WireRig& r) { r.freeze_gauges(false); }, [](const WireRig& r) { return guard_stale(r, GuardSource::wrench); },
+       nullptr},
       {"F/T status bit", WireDevice::sensor, "status supply low",
        [](WireRig& r) { r.sensor_emulator->set_status(static_cast<std::uint16_t>(hal::kFtSupplyLow)); },
        [](WireRig& r) { r.sensor_emulator->set_status(0); },
@@ -92,8 +91,7 @@ std::vector<WireFault> wire_faults() {
        [](const WireRig& r) { return r.supervisor->camera_monitor().counters().frozen; },
        [](const WireRig& r) { return r.observer->fault_counters().of(hal::FaultKind::freeze_data); },
        kCameraHoldCycles},
-      {"clock jump", WireDevice::clock, "reading +50 ms",
-       [](WireRig& r) { r.jump_clock(0.05); }, nullptr,
+      {"clock jump", WireDevice::clock, "reading +50 ms", [](WireRig& r) { r.jump_clock(0.05); }, nullptr,
        [](const WireRig& r) { return guard_stale(r, GuardSource::clock); }, nullptr, 1},
   };
 }

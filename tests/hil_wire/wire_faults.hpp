@@ -25,10 +25,10 @@ struct WireFault {
   WireDevice device;
   const char* injected;  ///< what the rig does, for the table
   void (*inject)(WireRig&);
-  void (*clear)(WireRig&);                        ///< nullptr: the fault ends by itself
-  std::uint64_t (*counted)(const WireRig&);       ///< the stack's count of it: must move
-  std::uint64_t (*delivered)(const WireRig&);     ///< camera: the mock's count of faulty frames; else nullptr
-  long hold_cycles = 30;                          ///< cycles from inject to clear
+  void (*clear)(WireRig&);                     ///< nullptr: the fault ends by itself
+  std::uint64_t (*counted)(const WireRig&);    ///< the stack's count of it: must move
+  std::uint64_t (*delivered)(const WireRig&);  ///< camera: the mock's count of faulty frames; else nullptr
+  long hold_cycles = 30;                       ///< cycles from inject to clear
 };
 
 const char* wire_device_name(WireDevice device) noexcept;

@@ -53,8 +53,8 @@ WireRig::WireRig(const HilObject& object, const WireOptions& options)
   }
   finger_sensor = std::make_unique<RecordingForceTorque>(*sensor);
   finger_gripper = std::make_unique<FingerForceGripper>(*gripper, *finger_sensor, 0);
-  for (hal::Device* d : {static_cast<hal::Device*>(finger_gripper.get()), static_cast<hal::Device*>(finger_sensor.get()),
-                         static_cast<hal::Device*>(observer.get())}) {
+  for (hal::Device* d : {static_cast<hal::Device*>(finger_gripper.get()),
+                         static_cast<hal::Device*>(finger_sensor.get()), static_cast<hal::Device*>(observer.get())}) {
     status_ = d->configure();
     if (status_ != hal::HalStatus::ok) return;
   }
