@@ -164,11 +164,11 @@ TEST(HilWireSoak, TenMinutesOfGraspingWithRandomFaults) {
   EXPECT_EQ(descriptors_after, descriptors_before) << "file descriptors leaked";
   EXPECT_GT(total_faults, grasps) << "too few faults for a soak";
   std::printf(
-      "\nWire HIL soak: %.0f s simulated in %ld grasps, %ld faults (worst latency %ld cycles), worst overshoot %.1f %%, "
+      "\nWire HIL soak: %.0f s simulated in %ld grasps, %ld faults (worst latency %ld cycles), worst overshoot %.1f "
+      "%%, "
       "open fds %d -> %d, first grasp's one-time heap blocks %lld; wall time %.0f s\n",
       simulated_s, grasps, total_faults, worst_latency, 100 * worst_overshoot, descriptors_before, descriptors_after,
-      first_net,
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+      first_net, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
 }
 
 }  // namespace
