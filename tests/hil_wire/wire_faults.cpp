@@ -39,7 +39,7 @@ const char* wire_device_name(WireDevice device) noexcept {
 
 std::vector<WireFault> wire_faults() {
   return {
-      {"Modbus timeout", WireDevice::gripper, "drop_replies(3)", [](WireRig& r) { r.gripper_emulator.drop_replies(3); },
+      {"Modbus timeout", WireDevice::gripper, "drop_replies(1)", [](WireRig& r) { r.gripper_emulator.drop_replies(1); },
        nullptr, [](const WireRig& r) { return r.gripper->link_counters().timeouts; }, nullptr},
       {"Modbus exception", WireDevice::gripper, "fc04 -> exception 1",
        [](WireRig& r) { r.gripper_emulator.set_fc04_supported(false); },

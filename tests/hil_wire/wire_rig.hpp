@@ -47,7 +47,7 @@ inline constexpr double kWireStrainMargin = 0.05;
 struct WireOptions {
   RigOptions base;  ///< rates, camera, prediction table, seed (pregrasp_gap_m unused: fingers start open)
   double strain_margin = kWireStrainMargin;
-  double modbus_timeout_s = 0.1;       ///< a Modbus answer's budget (wall time: the emulator runs in a thread)
+  double modbus_timeout_s = 0.5;       ///< a Modbus answer's budget (wall time: the emulator runs in a thread)
   double reconnect_interval_s = 0.01;  ///< Modbus and CAN, on the stepped clock
   double gauge_noise_counts = 3;       ///< sd of each strain gauge
   int storm_frames = 200;              ///< error frames per cycle while a storm runs: over 2 reads' budget (64 each)
