@@ -185,7 +185,7 @@ void Supervisor::command(const GraspGuardOutput& out) {
       if (phase_ == Phase::approach) {
         width = visible_width_m_ + config_.approach_gap_m;
         speed = config_.approach_speed_m_per_s;
-        if (have_width_ && width_m_ <= width + 1e-4) phase_ = Phase::squeeze;
+        if (have_width_ && width_m_ <= width + config_.approach_tolerance_m) phase_ = Phase::squeeze;
       }
       if (phase_ == Phase::squeeze) {
         width = visible_width_m_ * (1 - config_.target_closure_fraction);

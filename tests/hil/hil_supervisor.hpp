@@ -36,6 +36,9 @@ struct SupervisorConfig {
   double close_speed_m_per_s = 0.004;
   double approach_speed_m_per_s = 0.05;
   double approach_gap_m = 0.0015;  ///< approach ends this far outside the visible width
+  /// ... once the width read is within this of that target (a gripper whose width comes in
+  /// position counts, e.g. a Robotiq's 0.33 mm, needs about one count).
+  double approach_tolerance_m = 1e-4;
   double open_speed_m_per_s = 0.02;
   double open_margin_m = 0.002;
   double target_closure_fraction = 0.45;  ///< squeeze target: this fraction of the width, far past safe

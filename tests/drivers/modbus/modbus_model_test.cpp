@@ -117,6 +117,43 @@ TEST(Robotiq2fModel, SoftObjectIsSqueezedUntilTheForceLimit) {
   EXPECT_NEAR(m.grip_force_n(), 50.0, 1e-9);
 }
 
+// An object of the caller's replaces the spring: a quadratic law F = q (w0 - w)^2 past w0.
+class QuadraticObject final : public Robotiq2fObject {
+ public:
+  double force_n(double width_m) const noexcept override {
+    const double c = kTouch - width_m;
+    return c > 0 ? kGain * c * c : 0.0;
+  }
+  double width_at_force(double force_n) const noexcept override { return kTouch - std::sqrt(force_n / kGain); }
+  static constexpr double kTouch = 0.06;  // m
+  static constexpr double kGain = 1e5;    // N/m^2: 20 N at 14.1 mm closure
+};
+
+TEST(Robotiq2fModel, ObjectModelReplacesTheSpring) {
+  Robotiq2fModelConfig c;
+  c.object_width_m = 0.05;  // the spring: ignored while the object model is set
+  c.object_stiffness_n_per_m = 1000;
+  Robotiq2fModel m = activated_model(c);
+  const QuadraticObject object;
+  m.set_object_model(&object);
+  m.write_command(command(kGo, 255, 255, 0));  // force byte 0: 20 N
+  m.step(0.1);                                 // 150 mm/s: at 0.07, before the object
+  EXPECT_NEAR(m.width_m(), 0.070, 1e-12);
+  EXPECT_DOUBLE_EQ(m.grip_force_n(), 0.0);
+  m.step(0.1);  // would reach 0.055: 5 mm into the object, 2.5 N
+  EXPECT_NEAR(m.width_m(), 0.055, 1e-12);
+  EXPECT_NEAR(m.grip_force_n(), 2.5, 1e-9);
+  EXPECT_EQ(m.status().gobj, r2f::kObjMoving);
+  EXPECT_EQ(m.status().current, static_cast<std::uint8_t>(std::lround((0.05 + 0.003 * 2.5) / 0.01)));
+  m.step(1.0);  // stops where the object's force reaches 20 N
+  EXPECT_NEAR(m.width_m(), QuadraticObject::kTouch - std::sqrt(20 / QuadraticObject::kGain), 1e-12);
+  EXPECT_NEAR(m.grip_force_n(), 20.0, 1e-9);
+  EXPECT_EQ(m.status().gobj, r2f::kObjContactClosing);
+  // Without it the spring is back: at this width it pushes 1000 N/m x (0.05 - w).
+  m.set_object_model(nullptr);
+  EXPECT_NEAR(m.grip_force_n(), 1000 * (0.05 - m.width_m()), 1e-9);
+}
+
 TEST(Robotiq2fModel, PositionLimitedSqueezeEndsAtPosition) {
   Robotiq2fModelConfig c;
   c.object_width_m = 0.05;

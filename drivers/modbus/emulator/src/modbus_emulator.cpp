@@ -457,6 +457,11 @@ void ModbusEmulator::set_object(double width_m, double stiffness_n_per_m) {
   impl_->model.set_object(width_m, stiffness_n_per_m);
 }
 
+void ModbusEmulator::set_object_model(const Robotiq2fObject* object) {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  impl_->model.set_object_model(object);
+}
+
 void ModbusEmulator::set_gripper_width(double width_m) {
   std::lock_guard<std::mutex> lock(impl_->mutex);
   impl_->model.set_width(width_m);

@@ -10,12 +10,14 @@ Robotiq2fModel::Robotiq2fModel(const Robotiq2fModelConfig& config) noexcept
     : config_(config), width_m_(config.scaling.stroke_m) {}
 
 bool Robotiq2fModel::has_object() const noexcept {
+  if (object_ != nullptr) return true;
   return std::isfinite(config_.object_width_m) && config_.object_stiffness_n_per_m > 0;
 }
 
-// Width at which the squeeze force reaches the commanded force limit.
+// Width at which the squeeze force reaches the commanded force limit (NaN: never).
 double Robotiq2fModel::contact_stop_width() const noexcept {
   const double limit_n = r2f::byte_to_force(command_.force, config_.scaling);
+  if (object_ != nullptr) return object_->width_at_force(limit_n);
   if (std::isinf(config_.object_stiffness_n_per_m)) return config_.object_width_m;
   return config_.object_width_m - limit_n / config_.object_stiffness_n_per_m;
 }
@@ -106,6 +108,7 @@ void Robotiq2fModel::step(double dt_s) noexcept {
 }
 
 double Robotiq2fModel::grip_force_n() const noexcept {
+  if (object_ != nullptr) return std::max(0.0, object_->force_n(width_m_));
   if (!has_object() || width_m_ > config_.object_width_m) return 0;
   if (std::isinf(config_.object_stiffness_n_per_m)) {
     const bool holding =

@@ -102,6 +102,10 @@ class ModbusEmulator {
   // Simulation.
   void advance(double dt_s);
   void set_object(double width_m, double stiffness_n_per_m);
+  /// The gripper squeezes `object` instead of its spring (Robotiq2fModel::set_object_model;
+  /// nullptr: the spring). Its members are called under the emulator's lock, from the server
+  /// thread too; it must outlive the emulator's use of it (clear it or stop() first).
+  void set_object_model(const Robotiq2fObject* object);
   void set_gripper_width(double width_m);
   void set_gripper_fault(std::uint8_t fault_byte);
   void set_wrench(const double wrench[6]);

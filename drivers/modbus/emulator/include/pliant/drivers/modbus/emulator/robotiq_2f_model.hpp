@@ -15,6 +15,10 @@
 //     -> gOBJ = 3 (a position-limited squeeze). Opening always reaches rPR -> gOBJ = 3.
 //   - Grip force: k * max(0, object_width - width); for a rigid object held after contact, the
 //     force limit of rFR.
+//   - Another object: set_object_model(object) replaces the spring by an object of the caller's
+//     (Robotiq2fObject below, e.g. a simulated soft object in a HIL rig): closing stops where its
+//     force reaches the force limit (width_at_force), and the grip force, the current and gOBJ
+//     follow its force_n(width). set_object_model(nullptr) goes back to the spring.
 //   - Current gCU: moving_current_a while moving plus current_per_newton_a * grip force.
 //   - Faults: set_fault(byte) puts `byte` in status byte 2 (gFLT low nibble, kFLT high) and
 //     stops the fingers; commands are latched but do not move them while the fault lasts, and
@@ -42,6 +46,25 @@ struct Robotiq2fModelConfig {
   double moving_current_a = 0.05;                                             ///< >= 0
 };
 
+/// An object between the fingers other than the built-in spring. The model calls it from
+/// step() and from the status getters; in a ModbusEmulator that is under the emulator's lock, on
+/// the server thread as well as the caller's: both members must be safe to call from there
+/// (e.g. read only state that is fixed while the emulator runs). noexcept, allocation-free.
+class Robotiq2fObject {
+ public:
+  virtual ~Robotiq2fObject() = default;
+  /// Grip force (N, >= 0) with the fingers at width_m; it must not decrease as width_m shrinks.
+  virtual double force_n(double width_m) const noexcept = 0;
+  /// The widest width at which force_n(width) reaches `force_n`; NaN when it never does inside
+  /// the stroke (the fingers then close to their target).
+  virtual double width_at_force(double force_n) const noexcept = 0;
+
+ protected:
+  Robotiq2fObject() = default;
+  Robotiq2fObject(const Robotiq2fObject&) = default;
+  Robotiq2fObject& operator=(const Robotiq2fObject&) = default;
+};
+
 class Robotiq2fModel {
  public:
   explicit Robotiq2fModel(const Robotiq2fModelConfig& config = {}) noexcept;
@@ -65,6 +88,9 @@ class Robotiq2fModel {
 
   /// Replaces the object (width NaN removes it; stiffness > 0, +inf rigid).
   void set_object(double width_m, double stiffness_n_per_m) noexcept;
+  /// Squeezes `object` instead of the spring from now on (nullptr: the spring again). The
+  /// object must outlive its use here.
+  void set_object_model(const Robotiq2fObject* object) noexcept { object_ = object; }
   /// Fault byte (0 clears): see the top of the file.
   void set_fault(std::uint8_t fault_byte) noexcept;
   /// Puts the fingers at width_m (clamped to the stroke) and stops them: test set-up.
@@ -75,6 +101,7 @@ class Robotiq2fModel {
   double contact_stop_width() const noexcept;
 
   Robotiq2fModelConfig config_;
+  const Robotiq2fObject* object_ = nullptr;  ///< replaces the spring when set
   robotiq2f::Command command_;
   double width_m_ = 0;
   std::uint8_t gsta_ = robotiq2f::kStaReset;
