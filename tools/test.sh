@@ -7,7 +7,7 @@
 #              dependencies resolved by apt, and the install consumer built against them unpacked
 #   sanitize   AddressSanitizer + UndefinedBehaviorSanitizer build of what parses outside input or
 #              runs real-time code (PLIANT_SANITIZE_SCOPE=input, see tests/CMakeLists.txt), and
-#              its tests except the slow acceptance runs
+#              its tests except the slow acceptance runs and the wire HIL's 10-minute soak
 #   cross      tools/cross.sh: the aarch64 tests under qemu, the Cortex-M7 firmware with its
 #              no-allocator check
 #   fuzz       a short libFuzzer smoke run of every parser and decoder (.ci/fuzz_smoke.sh)
@@ -67,7 +67,7 @@ sanitize() {
     -DPLIANT_SANITIZE_SCOPE=input -DPLIANT_BUILD_BENCHMARKS=OFF > /dev/null
   cmake --build build-asan -j"$jobs"
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-    ctest --test-dir build-asan -j"$jobs" --output-on-failure -LE acceptance -E install_consumer
+    ctest --test-dir build-asan -j"$jobs" --output-on-failure -LE 'acceptance|soak' -E install_consumer
 }
 
 package() { bash tools/packages.sh build; }
