@@ -213,6 +213,7 @@ void Supervisor::command(const GraspGuardOutput& out) {
 
 const CycleReport& Supervisor::cycle() {
   report_ = CycleReport{};
+  report_.cycle_start_at = std::chrono::steady_clock::now();
   report_.cycle = cycles_++;
   const double now = clock_.now_s();
   report_.now_s = now;
@@ -220,6 +221,7 @@ const CycleReport& Supervisor::cycle() {
   // Reads: every device, every cycle (each returns at once).
   hal::GripperReading g;
   report_.gripper_read = gripper_.read(g);
+  report_.gripper_sample_at = std::chrono::steady_clock::now();
   std::uint32_t g_flags = 0;
   if (report_.gripper_read == hal::HalStatus::ok) {
     const double values[3] = {g.width_m, g.force_n, g.current_a};
@@ -272,8 +274,10 @@ const CycleReport& Supervisor::cycle() {
   }
   input_.now_s = now;
   (void)grasp_guard_update(guard_, input_, report_.out);
+  report_.verdict_at = std::chrono::steady_clock::now();
   report_.guarded = true;
   command(report_.out);
+  report_.cycle_end_at = std::chrono::steady_clock::now();
   report_.phase = phase_;
   return report_;
 }

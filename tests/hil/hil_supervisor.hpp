@@ -19,6 +19,7 @@
 // once, when learning ends; afterwards a cycle allocates nothing.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <vector>
 
@@ -68,6 +69,10 @@ struct CycleReport {
   hal::HalStatus command = hal::HalStatus::no_data;  ///< last write's status this cycle (no_data: none)
   bool new_frame = false;
   double command_width_m = 0;
+  /// Monotonic wall-clock instants (for latency benchmarks): the cycle began (its gripper read
+  /// went out), the gripper read returned, the guard's verdict was out, the cycle ended (after
+  /// its command went out).
+  std::chrono::steady_clock::time_point cycle_start_at{}, gripper_sample_at{}, verdict_at{}, cycle_end_at{};
 };
 
 class Supervisor {
