@@ -207,7 +207,7 @@ int main(int argc, char** argv) {
       "threads)\n\n",
       AdvectionConfig{}.refine_window_px);
   std::printf("%-10s %-10s %-36s %8s %8s %8s %10s  %s\n", "frame", "flow", "settings", "wall ms", "wall f/s", "cpu ms",
-              "2-core f/s", "target (CPU time)");
+              "2-core f/s", load ? "target (wall time)" : "target (CPU time)");
 
   struct Case {
     const char* name;
