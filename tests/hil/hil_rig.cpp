@@ -59,6 +59,9 @@ SupervisorConfig hil_supervisor_config(const HilObject& object, const RigOptions
   g.cycle_timeout_s = 3 * period;
   g.clock_tolerance_s = 0.5 * period;
   g.wrench_frozen_samples = 1;
+  // The plant settles between camera frames (hundreds of MSM steps per frame): the estimator's
+  // quasi-static row is its form (docs/hil.md, "The estimator's model forms").
+  c.estimator.equilibrium_iterations = kEquilibriumIterations;
   g.gripper_fault_mask = hal::kGripperFaultMask | hal::kStreamFaultMask;
   g.wrench_fault_mask = hal::kFtFaultMask | hal::kStreamFaultMask;
   g.camera_fault_mask = hal::kFrameFaultMask | hal::kStreamFaultMask;
