@@ -28,10 +28,18 @@ Status online_deformability_init(Arena& arena, const MsmModel<Dim, Scalar>& mode
   if (config.alpha_candidates < 1 || config.alpha_candidates > kMaxOnlineAlphaRows) return Status::invalid_argument;
   if (config.alpha_candidates > 1 && !(config.alpha_min > 0 && config.alpha_min < 1)) return Status::invalid_argument;
   if (config.step_candidates < 1 || config.step_candidates > kMaxOnlineStepRows) return Status::invalid_argument;
+  if (config.equilibrium_iterations < 0 || config.equilibrium_iterations > kMaxEquilibriumIterations ||
+      (config.equilibrium_iterations > 0 &&
+       !(std::isfinite(config.equilibrium_tolerance) && config.equilibrium_tolerance > 0))) {
+    return Status::invalid_argument;
+  }
   OnlineDeformability<Dim, Scalar> e;
   e.candidates = config.candidates;
   e.alpha_candidates = config.alpha_candidates;
   e.step_candidates = config.step_candidates;
+  e.quasi_static = config.equilibrium_iterations > 0;
+  e.equilibrium_iterations = config.equilibrium_iterations;
+  e.equilibrium_tolerance = config.equilibrium_tolerance * static_cast<double>(model.spacing);
   e.alpha_min = config.alpha_candidates > 1 ? config.alpha_min : 1.0;
   e.params = base;
   e.forgetting = config.forgetting;
@@ -41,6 +49,7 @@ Status online_deformability_init(Arena& arena, const MsmModel<Dim, Scalar>& mode
   const auto n = static_cast<std::size_t>(model.particle_count);
   e.step_start = arena.carve<Eigen::Matrix<Scalar, Dim, 1>>(n);
   e.step_targets = arena.carve<Eigen::Matrix<Scalar, Dim, 1>>(n);
+  if (e.quasi_static) e.previous = arena.carve<Eigen::Matrix<Scalar, Dim, 1>>(n);
   bool ok = !arena.exhausted();
   for (int c = 0; c < e.total_candidates(); ++c) {
     MsmState<Dim, Scalar> dummy;
@@ -77,6 +86,82 @@ void interval_start(const MsmModel<Dim, Scalar>& model, const MsmDrivenTargets<D
   }
 }
 
+// The largest distance any particle moved from `previous`.
+template <int Dim, typename Scalar>
+double largest_move(const MsmModel<Dim, Scalar>& model, const MsmState<Dim, Scalar>& state,
+                    const Eigen::Matrix<Scalar, Dim, 1>* previous) noexcept {
+  double largest = 0;
+  for (int i = 0; i < model.particle_count; ++i) {
+    largest = std::max(largest, static_cast<double>((state.position[i] - previous[i]).norm()));
+  }
+  return largest;
+}
+
+// The quasi-static row's frame: from where the candidate stood at the last frame, msm_steps
+// with the frame's driven targets until no particle moves more than the tolerance in two
+// successive iterations, or the iteration bound. The iterations carry momentum mu = 0.5 + 0.4
+// msm_beta (as the grasp guard's relaxation: the fixed point has zero velocity, so it is the
+// same, and the slow affine modes of high msm_beta settle several times faster); they run with
+// msm_alpha 1 and the frame's dt, so that gravity weighs as in the other rows. Returns the first
+// status that rejected a step, else ok; `relaxed` says whether the tolerance was reached.
+template <int Dim, typename Scalar>
+Status relax_towards_equilibrium(const MsmModel<Dim, Scalar>& model, OnlineDeformability<Dim, Scalar>& estimator,
+                                 MsmParams<Dim, Scalar> params, Scalar dt, const MsmDrivenTargets<Dim, Scalar>& driven,
+                                 MsmState<Dim, Scalar>& state, bool& relaxed) noexcept {
+  const Scalar momentum = Scalar(0.5) + Scalar(0.4) * params.msm_beta;
+  params.msm_alpha = Scalar(1);
+  params.velocity_damping = (Scalar(1) - momentum) / dt;  // per second: 1 - damping dt = momentum
+  MsmStepInput<Dim, Scalar> input;
+  input.dt = dt;
+  input.driven = driven;
+  for (int i = 0; i < model.particle_count; ++i) state.velocity[i].setZero();
+  int quiet = 0;
+  for (int iteration = 0; iteration < estimator.equilibrium_iterations && quiet < 2; ++iteration) {
+    for (int i = 0; i < model.particle_count; ++i) estimator.previous[i] = state.position[i];
+    const Status stepped = msm_step(model, params, input, state);
+    if (stepped == Status::invalid_argument || stepped == Status::not_initialized) return stepped;
+    quiet = largest_move(model, state, estimator.previous) <= estimator.equilibrium_tolerance ? quiet + 1 : 0;
+  }
+  relaxed = quiet >= 2;
+  return Status::ok;
+}
+
+// Advances candidate `c` over the frame interval in its row's form.
+template <int Dim, typename Scalar>
+Status advance_candidate(const MsmModel<Dim, Scalar>& model, OnlineDeformability<Dim, Scalar>& estimator, int c,
+                         Scalar dt, const MsmDrivenTargets<Dim, Scalar>& driven) noexcept {
+  const int k = estimator.candidates;
+  const int row = c / k;
+  MsmParams<Dim, Scalar> params = estimator.params;
+  params.msm_beta = static_cast<Scalar>(static_cast<double>(c % k) / (k - 1));
+  params.msm_alpha = static_cast<Scalar>(estimator.row_alpha(row));
+  MsmState<Dim, Scalar>& state = estimator.states[c];
+  if (estimator.is_quasi_static(row)) {
+    bool relaxed = false;
+    const Status status = relax_towards_equilibrium(model, estimator, params, dt, driven, state, relaxed);
+    if (!relaxed) ++estimator.unrelaxed;
+    return status;
+  }
+  const int steps = estimator.row_steps(row);
+  if (steps > 1) interval_start(model, driven, state, estimator.step_start);
+  return detail::step_frame_interval(model, params, dt, driven.ids, estimator.step_start, driven.positions,
+                                     driven.count, steps, estimator.step_targets, state);
+}
+
+// Squared residuals of the free observed particles of one candidate; `count` gets their scalars.
+template <int Dim, typename Scalar>
+double frame_squares(const MsmModel<Dim, Scalar>& model, const MsmState<Dim, Scalar>& state,
+                     const Eigen::Matrix<Scalar, Dim, 1>* observed, double& count) noexcept {
+  double squares = 0;
+  count = 0;
+  for (int i = 0; i < model.particle_count; ++i) {
+    if (model.fixed[i] != 0 || state.driven_now[i] != 0 || !observed[i].allFinite()) continue;
+    squares += (state.position[i] - observed[i]).template cast<double>().squaredNorm();
+    count += Dim;
+  }
+  return squares;
+}
+
 }  // namespace
 
 template <int Dim, typename Scalar>
@@ -92,30 +177,15 @@ Status online_deformability_update(const MsmModel<Dim, Scalar>& model, OnlineDef
     ++estimator.rejected_frames;
     return Status::invalid_argument;
   }
-  MsmParams<Dim, Scalar> params = estimator.params;
   double frame_count = 0;
-  const int k = estimator.candidates;
   for (int c = 0; c < estimator.total_candidates(); ++c) {
-    params.msm_beta = static_cast<Scalar>(static_cast<double>(c % k) / (k - 1));
-    params.msm_alpha = static_cast<Scalar>(estimator.row_alpha(c / k));
-    MsmState<Dim, Scalar>& state = estimator.states[c];
-    const int steps = estimator.row_steps(c / k);
-    if (steps > 1) interval_start(model, driven, state, estimator.step_start);
-    const Status stepped =
-        detail::step_frame_interval(model, params, dt, driven.ids, estimator.step_start, driven.positions, driven.count,
-                                    steps, estimator.step_targets, state);
+    const Status stepped = advance_candidate(model, estimator, c, dt, driven);
     if (stepped == Status::invalid_argument || stepped == Status::not_initialized) {
       ++estimator.rejected_frames;
       return Status::invalid_argument;
     }
-    double frame_squares = 0;
-    frame_count = 0;
-    for (int i = 0; i < model.particle_count; ++i) {
-      if (model.fixed[i] != 0 || state.driven_now[i] != 0 || !observed[i].allFinite()) continue;
-      frame_squares += (state.position[i] - observed[i]).template cast<double>().squaredNorm();
-      frame_count += Dim;
-    }
-    estimator.sum_squares[c] = estimator.forgetting * estimator.sum_squares[c] + frame_squares;
+    const double squares = frame_squares(model, estimator.states[c], observed, frame_count);
+    estimator.sum_squares[c] = estimator.forgetting * estimator.sum_squares[c] + squares;
   }
   estimator.residual_count = estimator.forgetting * estimator.residual_count + frame_count;
   ++estimator.frames;
@@ -175,7 +245,7 @@ FittedForm fitted_form(const RowMinimum* rows, const OnlineDeformability<Dim, Sc
   form.msm_beta = rows[form.row].msm_beta;
   form.sum_squares = rows[form.row].sum_squares;
   const int count = estimator.alpha_candidates;
-  if (count < 3) return form;
+  if (count < 3 || estimator.is_quasi_static(form.row)) return form;
   const int group = form.row - form.row % count;
   const int best = form.row % count;
   const int centre = best == 0 ? 1 : (best == count - 1 ? count - 2 : best);
@@ -211,11 +281,12 @@ OnlineDeformabilityEstimate online_deformability_estimate(const OnlineDeformabil
   out.msm_beta_std = std::numeric_limits<double>::infinity();
   if (!estimator.initialized() || estimator.residual_count < 2) return out;
   const int k = estimator.candidates;
-  RowMinimum rows[kMaxOnlineAlphaRows * kMaxOnlineStepRows];
+  RowMinimum rows[kMaxOnlineAlphaRows * kMaxOnlineStepRows + 1];
   for (int r = 0; r < estimator.rows(); ++r) rows[r] = row_minimum(estimator.sum_squares + r * k, k);
   const int held = estimator.alpha_candidates - 1;  // alpha 1 (or the base alpha), one step per frame
   const FittedForm fitted = fitted_form(rows, estimator);
-  const int extra = (estimator.alpha_candidates > 1 ? 1 : 0) + (estimator.step_candidates > 1 ? 1 : 0);
+  const int extra = (estimator.alpha_candidates > 1 ? 1 : 0) + (estimator.step_candidates > 1 ? 1 : 0) +
+                    (estimator.quasi_static ? 1 : 0);
   out.alpha_fitted =
       extra > 0 && form_determined(rows[held].sum_squares, fitted.sum_squares, estimator.residual_count / Dim, extra);
   const int answering = out.alpha_fitted ? fitted.row : held;

@@ -37,7 +37,8 @@
  *   simulation, and per-frame buffers: O(A S K (N + C) + memberships) bytes. Measured with the
  *   defaults (x86-64, A = 3, S = 1): a 4x4x3 block (N = 48) needs 893 KB computing in double;
  *   an 8x4 2D sheet 351 KB (with A = 1: 407 KB and 164 KB in double, 214 KB and 92 KB in
- *   float). Without the estimator a fifth of that.
+ *   float). Without the estimator a fifth of that. The quasi-static row (equilibrium_iterations
+ *   > 0) adds one form: K more states, and up to K x equilibrium_iterations MSM steps per frame.
  *   Ask pliant_workspace_size for your object.
  *   pliant_init is SLOW: it builds the models (O(N^2)) and the guard's prediction table
  *   (prediction_beta_points x (prediction_closure_points + prediction_refine_steps) quasi-static
@@ -140,7 +141,7 @@ extern "C" {
 
 /** Bumped whenever any struct or enumeration value of this header changes. A firmware
  *  compiled against a header with another ABI version is refused (PLIANT_ERROR_ABI_MISMATCH). */
-#define PLIANT_ABI_VERSION 2U
+#define PLIANT_ABI_VERSION 3U
 
 /** The library's version, packed as PLIANT_VERSION_NUMBER. Compare it with the header's
  *  PLIANT_VERSION_NUMBER to detect a stale library. Constant time, real-time safe. */
@@ -253,6 +254,12 @@ typedef struct pliant_estimator_config_s {
    *  tracker's prior msm_beta is set to the estimate. */
   bool feed_back_beta;
   double feed_back_max_std; /**< default 0.1 */
+  /** The quasi-static row (ABI 3): 0 (default) leaves it out; M in [1, 4096] adds K candidates
+   *  relaxed towards equilibrium every frame with at most M MSM iterations each, for objects
+   *  loaded slowly enough to stay near equilibrium (pliant_estimate_t.steps_per_frame is 0 when
+   *  it answers). It costs up to K x M MSM steps per frame. */
+  int32_t equilibrium_iterations;
+  double equilibrium_tolerance; /**< > 0, x model spacing: relaxed when no particle moves more; default 1e-4 */
 } pliant_estimator_config_t;
 
 /* Verdicts (pliant_verdict_t.verdict, fault_verdict[], uncertain_estimate_verdict). */
@@ -517,7 +524,7 @@ typedef struct pliant_estimate_s {
   double msm_beta_std;      /**< +inf until the residual curve has a positive curvature */
   double rms;               /**< rms residual of the best candidate, m */
   double msm_alpha;         /**< msm_alpha of the answering model form */
-  uint32_t steps_per_frame; /**< MSM steps per frame of the answering model form */
+  uint32_t steps_per_frame; /**< MSM steps per frame of the answering model form; 0: the quasi-static row */
   bool form_fitted;         /**< true: the frames determined a form other than alpha 1, one step */
   uint32_t frames;          /**< frames the estimator used since init / reset */
   bool unique_minimum;      /**< the residual curve has one basin */

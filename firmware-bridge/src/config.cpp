@@ -43,6 +43,8 @@ void default_estimator(pliant_estimator_config_t& out) noexcept {
   out.forgetting = core.forgetting;
   out.feed_back_beta = true;
   out.feed_back_max_std = 0.1;
+  out.equilibrium_iterations = core.equilibrium_iterations;
+  out.equilibrium_tolerance = core.equilibrium_tolerance;
 }
 
 void default_guard(pliant_guard_config_t& out) noexcept {
@@ -152,8 +154,12 @@ pliant_status_t validate_estimator(const pliant_estimator_config_t& e) noexcept 
   const bool rows_ok = e.alpha_candidates >= 1 && e.alpha_candidates <= kMaxOnlineAlphaRows && e.step_candidates >= 1 &&
                        e.step_candidates <= kMaxOnlineStepRows &&
                        (e.alpha_candidates == 1 || (e.alpha_min > 0 && e.alpha_min < 1));
-  const bool ok = rows_ok && e.candidates >= 3 && e.candidates <= kMaxCandidates && e.forgetting > 0 &&
-                  e.forgetting <= 1 && !std::isnan(e.feed_back_max_std) && e.feed_back_max_std >= 0;
+  const bool quasi_static_ok =
+      e.equilibrium_iterations == 0 ||
+      (e.equilibrium_iterations >= 1 && e.equilibrium_iterations <= kMaxEquilibriumIterations &&
+       std::isfinite(e.equilibrium_tolerance) && e.equilibrium_tolerance > 0);
+  const bool ok = rows_ok && quasi_static_ok && e.candidates >= 3 && e.candidates <= kMaxCandidates &&
+                  e.forgetting > 0 && e.forgetting <= 1 && !std::isnan(e.feed_back_max_std) && e.feed_back_max_std >= 0;
   return ok ? PLIANT_OK : PLIANT_ERROR_INVALID_ARGUMENT;
 }
 
@@ -263,6 +269,8 @@ OnlineDeformabilityConfig to_core(const pliant_estimator_config_t& estimator) no
   out.alpha_min = estimator.alpha_min;
   out.step_candidates = estimator.step_candidates;
   out.forgetting = estimator.forgetting;
+  out.equilibrium_iterations = estimator.equilibrium_iterations;
+  out.equilibrium_tolerance = estimator.equilibrium_tolerance;
   return out;
 }
 

@@ -140,6 +140,22 @@ std::vector<ConfigCase> bad_configs() {
        PLIANT_ERROR_INVALID_ARGUMENT},
       {"step rows 0", [](pliant_config_t& c) { c.estimator.step_candidates = 0; }, PLIANT_ERROR_INVALID_ARGUMENT},
       {"step rows 5", [](pliant_config_t& c) { c.estimator.step_candidates = 5; }, PLIANT_ERROR_INVALID_ARGUMENT},
+      {"equilibrium iterations -1", [](pliant_config_t& c) { c.estimator.equilibrium_iterations = -1; },
+       PLIANT_ERROR_INVALID_ARGUMENT},
+      {"equilibrium iterations 4097", [](pliant_config_t& c) { c.estimator.equilibrium_iterations = 4097; },
+       PLIANT_ERROR_INVALID_ARGUMENT},
+      {"equilibrium tolerance 0",
+       [](pliant_config_t& c) {
+         c.estimator.equilibrium_iterations = 8;
+         c.estimator.equilibrium_tolerance = 0;
+       },
+       PLIANT_ERROR_INVALID_ARGUMENT},
+      {"equilibrium tolerance NaN",
+       [](pliant_config_t& c) {
+         c.estimator.equilibrium_iterations = 8;
+         c.estimator.equilibrium_tolerance = kNaN;
+       },
+       PLIANT_ERROR_INVALID_ARGUMENT},
       {"forgetting 1.5", [](pliant_config_t& c) { c.estimator.forgetting = 1.5; }, PLIANT_ERROR_INVALID_ARGUMENT},
       {"feed back sd NaN", [](pliant_config_t& c) { c.estimator.feed_back_max_std = kNaN; },
        PLIANT_ERROR_INVALID_ARGUMENT},

@@ -53,6 +53,8 @@ TEST(BridgeDefaults, AreTheCoresDefaults) {
   EXPECT_EQ(c.estimator.alpha_candidates, estimator.alpha_candidates);
   EXPECT_EQ(c.estimator.alpha_min, estimator.alpha_min);
   EXPECT_EQ(c.estimator.step_candidates, estimator.step_candidates);
+  EXPECT_EQ(c.estimator.equilibrium_iterations, estimator.equilibrium_iterations);
+  EXPECT_EQ(c.estimator.equilibrium_tolerance, estimator.equilibrium_tolerance);
   EXPECT_TRUE(c.estimator.feed_back_beta);
 
   const GraspGuardConfig g;

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
+#include <vector>
 
 #include "press_observations.hpp"
 
@@ -140,6 +142,90 @@ TEST(OnlineDeformability, NoEvidenceMeansNoConfidence) {
   EXPECT_TRUE(
       refused([](pliant::OnlineDeformabilityConfig& c) { c.step_candidates = pliant::kMaxOnlineStepRows + 1; }));
   EXPECT_TRUE(refused([](pliant::OnlineDeformabilityConfig& c) { c.forgetting = 0; }));
+  EXPECT_TRUE(refused([](pliant::OnlineDeformabilityConfig& c) { c.equilibrium_iterations = -1; }));
+  EXPECT_TRUE(refused(
+      [](pliant::OnlineDeformabilityConfig& c) { c.equilibrium_iterations = pliant::kMaxEquilibriumIterations + 1; }));
+  EXPECT_TRUE(refused([](pliant::OnlineDeformabilityConfig& c) {
+    c.equilibrium_iterations = 8;
+    c.equilibrium_tolerance = 0;
+  }));
+  EXPECT_TRUE(refused([](pliant::OnlineDeformabilityConfig& c) {
+    c.equilibrium_iterations = 8;
+    c.equilibrium_tolerance = std::nan("");
+  }));
+}
+
+// The press of PressExperiment made by an object that settles between frames: every frame the
+// truth is relaxed to equilibrium under the tool's target (velocities zeroed every iteration,
+// no momentum: another iteration than the estimator's, with the same fixed point), then noised.
+struct SettledPress {
+  pliant::test::PressExperiment<2, double> experiment;
+
+  SettledPress(double beta, double rate_hz, double noise_std, unsigned seed)
+      : experiment(beta, 1.0, 0.0, seed, 8, 4, 3, 100.0, 60.0, 2.0, rate_hz) {
+    pliant::test::MsmFixture<2, double> truth(experiment.builder.config());
+    EXPECT_EQ(truth.status, Status::ok);
+    pliant::MsmParams<2, double> params;
+    params.msm_beta = beta;
+    std::mt19937 noise(seed);
+    std::normal_distribution<double> normal(0.0, noise_std);
+    const int n = truth.model.particle_count;
+    for (std::size_t k = 1; k < experiment.times.size(); ++k) {
+      const Eigen::Vector2d target(experiment.positions[coordinate(k, experiment.tool, 0, n)],
+                                   experiment.positions[coordinate(k, experiment.tool, 1, n)]);
+      relax(truth, params, target);
+      for (int i = 0; i < n; ++i) {
+        const double sd = i == experiment.tool ? 0.0 : 1.0;
+        for (int d = 0; d < 2; ++d) {
+          experiment.positions[coordinate(k, i, d, n)] = truth.state.position[i](d) + sd * normal(noise);
+        }
+      }
+    }
+  }
+
+  static std::size_t coordinate(std::size_t frame, int particle, int axis, int particle_count) {
+    return (frame * static_cast<std::size_t>(particle_count) + static_cast<std::size_t>(particle)) * 2 +
+           static_cast<std::size_t>(axis);
+  }
+
+  void relax(pliant::test::MsmFixture<2, double>& truth, const pliant::MsmParams<2, double>& params,
+             const Eigen::Vector2d& target) const {
+    pliant::MsmStepInput<2, double> input;
+    input.dt = 1.0;
+    input.driven = {&experiment.tool, &target, 1};
+    for (int iteration = 0; iteration < 20000; ++iteration) {
+      double largest = 0;
+      for (int i = 0; i < truth.model.particle_count; ++i) truth.state.velocity[i].setZero();
+      std::vector<Eigen::Vector2d> before(truth.state.position, truth.state.position + truth.model.particle_count);
+      EXPECT_EQ(pliant::msm_step(truth.model, params, input, truth.state), Status::ok);
+      for (int i = 0; i < truth.model.particle_count; ++i) {
+        largest = std::max(largest, (truth.state.position[i] - before[static_cast<std::size_t>(i)]).norm());
+      }
+      if (largest < 1e-9) return;
+    }
+    ADD_FAILURE() << "the truth did not settle";
+  }
+};
+
+pliant::OnlineDeformabilityConfig with_quasi_static_row() {
+  pliant::OnlineDeformabilityConfig config;
+  config.equilibrium_iterations = 64;
+  return config;
+}
+
+// The press at 10 Hz (6 % of the spacing per frame): the rows that step through the frame
+// interval misread it; the quasi-static row answers and reads msm_beta.
+TEST(OnlineDeformability, QuasiStaticRowReadsAnObjectThatSettlesBetweenFrames) {
+  for (double beta : {0.2, 0.5, 0.8}) {
+    const SettledPress press(beta, 10.0, 0.5, 21);
+    const auto stepped = run_online(press.experiment, pliant::OnlineDeformabilityConfig{});
+    const auto settled = run_online(press.experiment, with_quasi_static_row());
+    // One step per frame lags an object that settles: 0.08, 0.36, 0.66 when this was written.
+    EXPECT_GT(std::abs(stepped.msm_beta - beta), 0.1) << beta;
+    EXPECT_EQ(settled.steps_per_frame, 0) << beta;
+    EXPECT_TRUE(settled.alpha_fitted) << beta;
+    EXPECT_NEAR(settled.msm_beta, beta, 0.03) << beta;
+  }
 }
 
 }  // namespace

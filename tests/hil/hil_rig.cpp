@@ -59,6 +59,9 @@ SupervisorConfig hil_supervisor_config(const HilObject& object, const RigOptions
   g.cycle_timeout_s = 3 * period;
   g.clock_tolerance_s = 0.5 * period;
   g.wrench_frozen_samples = 1;
+  // The plant settles between camera frames (hundreds of MSM steps per frame): the estimator's
+  // quasi-static row is its form (docs/hil.md, "The estimator's model forms").
+  c.estimator.equilibrium_iterations = kEquilibriumIterations;
   // The fault masks stay the guard's defaults: each device's own fault bits plus the stream
   // monitor's flags, which the rig ORs into every sample's status word.
   c.gripper_monitor.max_interval_s = 3 * period;

@@ -44,7 +44,12 @@ struct RigOptions {
 /// that alone is worth up to ~2 % of strain.
 inline constexpr double kStrainMargin = 0.05;
 
-/// The supervisor configuration the HIL uses for an object (limits, timeouts, masks).
+/// MSM iterations per frame of the estimator's quasi-static row: about what a squeeze at 20 mm/s
+/// needs to settle each frame at the default tolerance (the 1-step rows lag this plant).
+inline constexpr int kEquilibriumIterations = 64;
+
+/// The supervisor configuration the HIL uses for an object (limits, timeouts, masks, the
+/// estimator's quasi-static row).
 SupervisorConfig hil_supervisor_config(const HilObject& object, const RigOptions& options);
 
 struct Rig {

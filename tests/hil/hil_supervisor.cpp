@@ -92,7 +92,9 @@ bool Supervisor::build() {
 }
 
 // A new frame: strain for the guard, and the estimator's update driven by the particles that
-// the frame shows at a jaw (the jaw planes from the latest gripper width).
+// the frame shows at a jaw (the jaw planes from the latest gripper width), once the guard has
+// seen contact: before that a jaw plane within the band is still outside the object, and moving
+// the particles onto it would teach the estimator a stretch the object never had.
 void Supervisor::on_frame(const hal::ParticleFrame& frame, std::uint32_t flags) {
   const int n = model_.particle_count;
   double strain = kNaN;
@@ -110,7 +112,7 @@ void Supervisor::on_frame(const hal::ParticleFrame& frame, std::uint32_t flags) 
                         frame.header.stamp_s > last_frame_stamp_s_;
     if (usable) {
       int count = 0;
-      if (have_width_) {
+      if (have_width_ && in_contact_) {
         const double band = config_.contact_band * model_.spacing;
         const double plane_a = -0.5 * width_m_, plane_b = 0.5 * width_m_;
         for (int i = 0; i < n; ++i) {
@@ -275,6 +277,7 @@ const CycleReport& Supervisor::cycle() {
   input_.now_s = now;
   (void)grasp_guard_update(guard_, input_, report_.out);
   report_.verdict_at = std::chrono::steady_clock::now();
+  in_contact_ = report_.out.in_contact;
   report_.guarded = true;
   command(report_.out);
   report_.cycle_end_at = std::chrono::steady_clock::now();

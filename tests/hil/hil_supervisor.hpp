@@ -3,7 +3,8 @@
 // Every control cycle it reads the gripper, the F/T sensor and the particle observer (a new
 // frame arrives at camera rate), runs each stream through a hal::StreamMonitor, turns the reads
 // into grasp-guard samples (hal/guard_inputs.hpp), measures the strain of each new frame
-// (grasp_guard_measure_strain), updates the online msm_beta estimate with it, runs
+// (grasp_guard_measure_strain), updates the online msm_beta estimate with it (driven by the
+// particles at the jaws once the guard reports contact), runs
 // grasp_guard_update and commands the gripper:
 //   ok    - close toward a target far deeper than any safe closure, but never past
 //           safe_width_m, at close_speed; the force command is the guard's allowed force;
@@ -121,6 +122,7 @@ class Supervisor {
   GraspGuardInput input_;
   bool have_width_ = false;
   double width_m_ = 0;
+  bool in_contact_ = false;  ///< the guard's contact state of the last cycle
 
   // learning
   std::vector<double> rest_sum_;
