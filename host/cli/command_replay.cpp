@@ -126,6 +126,11 @@ ReplayCommand::ReplayCommand(CLI::App& parent) {
   app_->add_flag("--no-estimate", no_estimate_, "do not run the online msm_beta estimate");
   app_->add_option("--msm-alpha", msm_alpha_, "hold msm_alpha at this value in (0, 1] (default: chosen online)")
       ->check(CLI::Range(1e-6, 1.0));
+  app_->add_option("--settled-row", settled_row_,
+                   "add the quasi-static row: candidates relaxed towards equilibrium every frame with at most N MSM "
+                   "iterations (for objects that settle between frames; 0: off)")
+      ->type_name("N")
+      ->capture_default_str();
   app_->add_option("-o,--output", output_, "JSON lines file (written when the replay ends)");
 }
 
@@ -140,6 +145,7 @@ int ReplayCommand::run() const {
     options.alpha_candidates = 1;
     options.step_candidates = 1;
   }
+  options.equilibrium_iterations = settled_row_;
   if (!faults_.empty()) options.fault_script = read_text_file(faults_);
 
   std::ostringstream buffered;

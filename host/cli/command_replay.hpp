@@ -30,6 +30,7 @@ class ReplayCommand {
   std::string faults_;
   bool no_estimate_ = false;
   std::optional<double> msm_alpha_;
+  int settled_row_ = 0;
   std::string output_;
 };
 

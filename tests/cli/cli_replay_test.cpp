@@ -65,6 +65,18 @@ TEST(CliReplay, TheOnlineEstimateChoosesTheModelFormOnAnotherSimulatorsPress) {
   EXPECT_GT(std::abs(old["msm_beta"].get<double>() - truth), 0.1);
 }
 
+// The quasi-static row beside the stepped ones: on a press that steps once per frame it must not
+// take over (the stepped rows explain it) and the estimate stays on the truth.
+TEST(CliReplay, TheSettledRowRunsBesideTheSteppedOnes) {
+  const CommandResult r = run_pliant("replay --stepped --settled-row 64 " + quoted(kFoamMedium));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json estimate = last_json_line(r.out)["summary"]["estimate"];
+  const double truth = truth_of(kFoamMedium)["parameters"]["msm_beta"];
+  EXPECT_NEAR(estimate["msm_beta"].get<double>(), truth, 0.05);
+  EXPECT_GE(estimate["steps_per_frame"].get<int>(), 1);
+  EXPECT_EQ(estimate["frames"], 135);
+}
+
 TEST(CliReplay, ScriptedFaultsReachTheDevicesAndAreCounted) {
   TempDir dir;
   write_text(dir / "faults.txt",
@@ -164,6 +176,12 @@ TEST(CliReplay, BadScriptsAndOptionsAreRefused) {
     r = run_pliant("replay --stepped --msm-alpha " + std::string(alpha) + " " + quoted(kFoamMedium));
     EXPECT_EQ(r.status, 2) << alpha;
   }
+  for (const char* iterations : {"-1", "4097", "x"}) {
+    r = run_pliant("replay --stepped --settled-row " + std::string(iterations) + " " + quoted(kFoamMedium));
+    EXPECT_EQ(r.status, 2) << iterations;
+  }
+  r = run_pliant("replay --stepped --settled-row 4097 " + quoted(kFoamMedium));
+  EXPECT_NE(r.err.find("the quasi-static row takes 0 to 4096 iterations per frame"), std::string::npos) << r.err;
   r = run_pliant("replay --stepped " + quoted(dir / "nothing"));
   EXPECT_EQ(r.status, 2);
   EXPECT_EQ(r.err.find("Sanitizer"), std::string::npos);

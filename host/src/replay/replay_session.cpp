@@ -43,6 +43,7 @@ class EstimatorOf final : public Estimator {
     config.candidates = options.candidates;
     config.alpha_candidates = options.alpha_candidates;
     config.step_candidates = options.step_candidates;
+    config.equilibrium_iterations = options.equilibrium_iterations;
     block_.resize(online_deformability_workspace_size(model_->model, config));
     Arena arena(block_.data(), block_.size());
     require_ok(online_deformability_init(arena, model_->model, base_params<Dim>(recording, options.msm_alpha), config,
@@ -153,6 +154,10 @@ ReplaySummary replay_recording(const Recording& recording, const ReplayOptions& 
   if (options.step_candidates < 1 || options.step_candidates > kMaxOnlineStepRows) {
     throw std::invalid_argument("the online estimator takes 1 to " + std::to_string(kMaxOnlineStepRows) +
                                 " rows of steps per frame");
+  }
+  if (options.equilibrium_iterations < 0 || options.equilibrium_iterations > kMaxEquilibriumIterations) {
+    throw std::invalid_argument("the quasi-static row takes 0 to " + std::to_string(kMaxEquilibriumIterations) +
+                                " iterations per frame");
   }
   if (!(options.msm_alpha > 0 && options.msm_alpha <= 1)) throw std::invalid_argument("msm_alpha must be in (0, 1]");
   const hal::FaultScript script = parse_script(options.fault_script);

@@ -41,6 +41,9 @@ struct ReplayOptions {
   int candidates = 21;       ///< online estimator msm_beta grid size per alpha row (>= 3)
   int alpha_candidates = 3;  ///< msm_alpha rows on [0.3, 1]; 1: hold msm_alpha
   int step_candidates = 3;   ///< rows at 1, 2, 4 MSM steps per frame; the form is chosen online by BIC
+  /// The quasi-static row (online_deformability.hpp): at most this many MSM iterations per
+  /// candidate and frame, [0, kMaxEquilibriumIterations]; 0 leaves the row out.
+  int equilibrium_iterations = 0;
 };
 
 enum class ReplayDevice : std::uint8_t { particles, wrench, gripper };
