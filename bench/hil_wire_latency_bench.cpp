@@ -16,10 +16,6 @@
 // controlled: quote figures with the machine's state.
 //
 //   hil_wire_latency_bench [--grasps N]     (N objects of the HIL suite per run, default 4)
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -29,6 +25,7 @@
 #include <vector>
 
 #include "hil_rig.hpp"
+#include "spinning_load.hpp"
 #include "wire_rig.hpp"
 
 #ifndef PLIANT_BENCH_BUILD_TYPE
@@ -44,30 +41,6 @@ using pliant::hil::WireRig;
 
 constexpr long kHoldCycles = 600;  // after the squeeze stopped, as the acceptance test runs
 constexpr long kMaxCycles = 8000;
-
-// `count` processes spinning for as long as this object lives.
-class SpinningProcesses {
- public:
-  explicit SpinningProcesses(int count) {
-    for (int i = 0; i < count; ++i) {
-      const pid_t pid = fork();
-      if (pid == 0) {
-        volatile unsigned long spin = 0;
-        for (;;) spin = spin + 1;
-      }
-      if (pid > 0) pids_.push_back(pid);
-    }
-  }
-  ~SpinningProcesses() {
-    for (pid_t pid : pids_) kill(pid, SIGKILL);
-    for (pid_t pid : pids_) waitpid(pid, nullptr, 0);
-  }
-  SpinningProcesses(const SpinningProcesses&) = delete;
-  SpinningProcesses& operator=(const SpinningProcesses&) = delete;
-
- private:
-  std::vector<pid_t> pids_;
-};
 
 double micros(std::chrono::steady_clock::time_point from, std::chrono::steady_clock::time_point to) {
   return std::chrono::duration<double, std::micro>(to - from).count();
@@ -141,7 +114,7 @@ int main(int argc, char** argv) {
   print("no added load", "cycle", idle.cycle_us);
   Samples loaded;
   {
-    const SpinningProcesses load(2);
+    const pliant::bench::SpinningProcesses load(2);
     loaded = run(objects, grasps);
   }
   print("2 spinning processes", "sample -> verdict", loaded.to_verdict_us);

@@ -20,10 +20,7 @@
 // 1080 "on two cores while another process loads one core".
 //
 //   webcam_track_bench [--frames N] [--quick] [--load]
-#include <signal.h>
-#include <sys/wait.h>
 #include <time.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <cmath>
@@ -38,6 +35,7 @@
 
 #include "pliant/vision/webcam_advection.hpp"
 #include "pliant/vision/webcam_tracker.hpp"
+#include "spinning_load.hpp"
 
 #ifndef PLIANT_BENCH_BUILD_TYPE
 #define PLIANT_BENCH_BUILD_TYPE "unknown"
@@ -83,31 +81,6 @@ std::vector<cv::Point2d> grid_points(cv::Size size, double spacing) {
   }
   return points;
 }
-
-// --load: a second process spinning on one core for the whole run (issue 20's condition for the
-// 1920 x 1080 target); it is killed when this object goes.
-class OneCoreLoad {
- public:
-  explicit OneCoreLoad(bool on) {
-    if (!on) return;
-    pid_ = fork();
-    if (pid_ == 0) {
-      volatile unsigned long spin = 0;
-      for (;;) spin = spin + 1;
-    }
-    if (pid_ > 0) std::printf("load: process %d spins on one core\n", static_cast<int>(pid_));
-  }
-  ~OneCoreLoad() {
-    if (pid_ <= 0) return;
-    kill(pid_, SIGKILL);
-    waitpid(pid_, nullptr, 0);
-  }
-  OneCoreLoad(const OneCoreLoad&) = delete;
-  OneCoreLoad& operator=(const OneCoreLoad&) = delete;
-
- private:
-  pid_t pid_ = -1;
-};
 
 struct Timing {
   double wall_ms = 0, cpu_ms = 0;
@@ -199,7 +172,7 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  const OneCoreLoad busy(load);
+  const pliant::bench::SpinningProcesses busy(load ? 1 : 0);
   std::printf("webcam_track_bench (build type %s, OpenCV %s, %d OpenCV threads)\n", PLIANT_BENCH_BUILD_TYPE, CV_VERSION,
               cv::getNumThreads());
   std::printf(
