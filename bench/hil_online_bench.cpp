@@ -56,7 +56,7 @@ std::string form(double alpha, int steps) {
 }
 
 void print_header() {
-  std::printf("%-16s %4s %5s %4s | %-17s | %-12s | %-17s %7s %7s | %-17s %7s %7s\n", "object", "mm/s", "beta", "fr",
+  std::printf("%-16s %4s %5s %4s | %-17s | %-22s | %-17s %7s %7s | %-17s %7s %7s\n", "object", "mm/s", "beta", "fr",
               "offline r1.5", "offline auto", "online before", "diff", "us", "online", "diff", "us");
 }
 
@@ -69,15 +69,16 @@ void compare(const HilObject& object, double speed_m_per_s, bool with_auto, Tall
   const OnlineRun old_rows = pliant::hil::run_online(recording, without_quasi_static_row(config));
   const OnlineRun online = pliant::hil::run_online(recording, config);
   const pliant::host::EstimateReport held = pliant::hil::run_offline(recording, false);
-  char automatic[32] = "-";
+  char automatic[48] = "-";
   if (with_auto) {
     const pliant::host::EstimateReport chosen = pliant::hil::run_offline(recording, true);
-    std::snprintf(automatic, sizeof automatic, "%.3f r%.2f", chosen.result.msm_beta, chosen.cluster_radius_factor);
+    std::snprintf(automatic, sizeof automatic, "%.3f+-%.3f r%.2f", chosen.result.msm_beta, chosen.msm_beta_std,
+                  chosen.cluster_radius_factor);
   }
   const double offline = held.result.msm_beta;
   before.add(old_rows.estimate.msm_beta - offline);
   after.add(online.estimate.msm_beta - offline);
-  std::printf("%-16s %4.0f %5.2f %4d | %5.3f %-11s | %-12s | %5.3f %-11s %+7.3f %7.0f | %5.3f %-11s %+7.3f %7.0f\n",
+  std::printf("%-16s %4.0f %5.2f %4d | %5.3f %-11s | %-22s | %5.3f %-11s %+7.3f %7.0f | %5.3f %-11s %+7.3f %7.0f\n",
               object.name.c_str(), 1000 * speed_m_per_s, object.object.msm_beta, recording.frame_count(), offline,
               form(held.result.msm_alpha, held.baseline.steps_per_frame()).c_str(), automatic,
               old_rows.estimate.msm_beta, form(old_rows.estimate.msm_alpha, old_rows.estimate.steps_per_frame).c_str(),

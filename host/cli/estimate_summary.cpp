@@ -116,8 +116,11 @@ std::string format_estimate_summary(const host::Recording& recording, const host
   text += format("mode        %s\n", host::fit_mode_name(options.mode));
   text += format("msm_beta    %.3f ", r.msm_beta) + uncertainty_text(report.msm_beta_std) + "\n";
   if (std::isfinite(report.msm_beta_std)) {
-    text += format("            (1 sd: %.2g from the error curve, %.2g from input noise of %.3g %s)\n",
-                   report.msm_beta_std_curvature, report.msm_beta_std_input, report.noise_std, unit.c_str());
+    text += format(
+        "            (1 sd: %.2g from the error curve, %.2g from input noise of %.3g %s, %.2g from the "
+        "model's form)\n",
+        report.msm_beta_std_curvature, report.msm_beta_std_input, report.noise_std, unit.c_str(),
+        report.msm_beta_std_model_form);
   }
   text += format("msm_alpha   %.3f (%s)\n", r.msm_alpha, report.baseline.alpha_fitted() ? "fitted" : "held");
   text += "baseline    " + report.baseline.reason + "\n";

@@ -175,6 +175,8 @@ void score_candidates(const std::vector<MsmFit<Dim>>& fits, BaselineChoice& choi
 constexpr double kExplainedByNoise = 1.5;
 // Radii tried in each gap between fitted cluster radii (fit_baseline, step 3).
 constexpr int kRadiiPerGap = 2;
+// Bisections between doubled steps per frame (fit_baseline, step 2): 16 and 32 narrow to 4 apart.
+constexpr int kStepBisections = 2;
 
 bool explained_by_noise(double rms, double noise_std) { return noise_std > 0 && rms <= kExplainedByNoise * noise_std; }
 
@@ -224,7 +226,9 @@ std::string choice_reason(const BaselineChoice& choice, bool compared_alpha, boo
 // 1. the simplest variant (msm_alpha held, the first steps per frame, the setup's cluster
 //    radius); kept at once when it fits to the measured noise;
 // 2. at the current radius, every steps per frame (automatic: 1..max_auto_steps_per_frame) with
-//    msm_alpha held and fitted as the options say;
+//    msm_alpha held and fitted as the options say; when the most steps win, doubled steps while
+//    they keep winning (up to max_steps_per_frame), then kStepBisections bisections around the
+//    kept count;
 // 3. with the cluster radius automatic, the steps and msm_alpha mode kept so far at every radius
 //    of the setup's and auto_cluster_radii;
 //    then, in every gap between two radii fitted so far (in later rounds only beside the kept
@@ -326,6 +330,51 @@ MsmFit<Dim> fit_baseline(const Recording& recording, const EstimateOptions& opti
     return between;
   };
 
+  // When the most steps per frame tried fits best, the object moves further between frames than
+  // those steps can follow (it settles within a frame interval: a fast squeeze seen by a slow
+  // camera). Doubles the steps, in the kept variant's msm_alpha modes and radius, while the
+  // doubled count keeps winning, up to max_steps_per_frame.
+  // Past the edge the counts tried are a factor of 2 apart: bisects between the kept count and the
+  // nearest counts tried on either side of it (kept modes and radius), a few times.
+  auto refine_steps_between_doublings = [&]() {
+    for (int round = 0; round < kStepBisections; ++round) {
+      const BaselineCandidate form = kept();
+      if (form.steps_per_frame <= last_steps) return;
+      int below = 0;
+      int above = 0;
+      for (const BaselineCandidate& c : choice.candidates) {
+        if (c.alpha_fitted != form.alpha_fitted || c.cluster_radius_factor != form.cluster_radius_factor) continue;
+        if (c.steps_per_frame < form.steps_per_frame) below = std::max(below, c.steps_per_frame);
+        if (c.steps_per_frame > form.steps_per_frame && (above == 0 || c.steps_per_frame < above)) {
+          above = c.steps_per_frame;
+        }
+      }
+      std::vector<int> counts;
+      if (below > 0 && form.steps_per_frame - below > 1) counts.push_back((below + form.steps_per_frame) / 2);
+      if (above > 0 && above - form.steps_per_frame > 1) counts.push_back((form.steps_per_frame + above) / 2);
+      if (counts.empty()) return;
+      std::vector<Variant> forms;
+      for (int count : counts) {
+        if (!alpha_fit) forms.push_back({count, false, form.cluster_radius_factor});
+        if (alpha_auto || alpha_fit) forms.push_back({count, true, form.cluster_radius_factor});
+      }
+      add(forms);
+    }
+  };
+  auto steps_past_the_edge = [&]() {
+    for (int steps = kept().steps_per_frame; steps >= last_steps && steps < max_steps_per_frame;) {
+      const int more = std::min(2 * steps, max_steps_per_frame);
+      const double at = kept().cluster_radius_factor;
+      std::vector<Variant> forms;
+      if (!alpha_fit) forms.push_back({more, false, at});
+      if (alpha_auto || alpha_fit) forms.push_back({more, true, at});
+      add(forms);
+      if (kept().steps_per_frame != more) break;
+      steps = more;
+    }
+    refine_steps_between_doublings();
+  };
+
   add({{first_steps, alpha_fit, setup_radius}});
   const bool choosing = alpha_auto || steps_auto || radius_auto;
   if (choosing && !alpha_fit && explained_by_noise(fits.front().result.rms, models.front().second->noise_std)) {
@@ -345,6 +394,7 @@ MsmFit<Dim> fit_baseline(const Recording& recording, const EstimateOptions& opti
         if (alpha_auto || alpha_fit) forms.push_back({steps, true, radius});
       }
       add(forms);
+      if (steps_auto) steps_past_the_edge();
       if (!radius_auto) break;
       const BaselineCandidate form = kept();
       std::vector<Variant> radii{{form.steps_per_frame, form.alpha_fitted, setup_radius}};
@@ -411,7 +461,10 @@ EstimateReport run(const Recording& recording, const EstimateOptions& options) {
   refit.cluster_radius_auto = false;
   refit.setup.clusters.radius_factor = report.cluster_radius_factor;
   report.msm_beta_std_input = input_noise_std<Dim>(recording, refit, *model, report.noise_std, staged, fits);
-  report.msm_beta_std = std::hypot(report.msm_beta_std_curvature, report.msm_beta_std_input);
+  report.msm_beta_std_model_form = report.baseline.msm_beta_spread();
+  report.msm_beta_std = std::sqrt(report.msm_beta_std_curvature * report.msm_beta_std_curvature +
+                                  report.msm_beta_std_input * report.msm_beta_std_input +
+                                  report.msm_beta_std_model_form * report.msm_beta_std_model_form);
   report.runtime_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return report;
 }
@@ -424,6 +477,24 @@ double finite_or(double value, double fallback) { return std::isfinite(value) ? 
 EstimateReport estimate_recording(const Recording& recording, const EstimateOptions& options) {
   if (recording.frame_count() < 2) throw std::runtime_error("the recording has fewer than two frames");
   return recording.dimension == 2 ? run<2>(recording, options) : run<3>(recording, options);
+}
+
+// Each variant's weight exp(-(BIC - BIC_kept) / 2) is the Schwarz approximation of its posterior
+// probability relative to the kept one (Kass and Raftery 1995). A clear choice leaves the spread
+// near 0; forms within a few BIC units that read msm_beta differently (a cluster radius the frames
+// do not determine) widen it.
+double BaselineChoice::msm_beta_spread() const {
+  if (candidates.size() < 2) return 0.0;
+  const BaselineCandidate& kept = candidates[static_cast<std::size_t>(chosen)];
+  double weights = 0;
+  double spread = 0;
+  for (const BaselineCandidate& c : candidates) {
+    if (!std::isfinite(c.bic) || !std::isfinite(c.msm_beta)) continue;
+    const double weight = std::exp(-0.5 * (c.bic - kept.bic));
+    weights += weight;
+    spread += weight * (c.msm_beta - kept.msm_beta) * (c.msm_beta - kept.msm_beta);
+  }
+  return weights > 0 ? std::sqrt(spread / weights) : 0.0;
 }
 
 const char* alpha_mode_name(AlphaMode mode) {
@@ -528,6 +599,7 @@ nlohmann::json estimate_json(const Recording& recording, const EstimateOptions& 
       {"noise_std", report.noise_std},
       {"msm_beta_std_curvature", finite_or(report.msm_beta_std_curvature, 1.0)},
       {"msm_beta_std_input_noise", report.msm_beta_std_input},
+      {"msm_beta_std_model_form", report.msm_beta_std_model_form},
       {"input_noise_samples", options.input_noise_samples},
       {"runtime_s", report.runtime_s},
   };

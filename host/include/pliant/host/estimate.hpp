@@ -27,7 +27,8 @@ namespace pliant::host {
 /// - fixed: msm_alpha held at `msm_alpha` (the behaviour before automatic was the default).
 enum class AlphaMode : std::uint8_t { automatic, fitted, fixed };
 
-/// Largest MSM steps per frame interval the automatic choice tries.
+/// Largest MSM steps per frame interval the automatic choice tries first; when that many win, it
+/// doubles them while the doubled count keeps winning, up to max_steps_per_frame.
 inline constexpr int max_auto_steps_per_frame = 4;
 
 /// Cluster radii (times the median nearest-neighbour distance of the rest shape) the automatic
@@ -43,7 +44,8 @@ struct EstimateOptions {
   AlphaMode alpha = AlphaMode::automatic;
   double msm_alpha = 1.0;  ///< in (0, 1]: the held value (fixed, and the alternative automatic weighs)
   /// Trajectory mode: MSM steps per frame interval. 0 = chosen by the baseline selection among
-  /// 1..max_auto_steps_per_frame; else held at that value (1..max_steps_per_frame).
+  /// 1..max_auto_steps_per_frame (and doubled counts beyond, see above); else held at that value
+  /// (1..max_steps_per_frame).
   int steps_per_frame = 0;
   /// Trajectory mode, radius cluster layout: also try auto_cluster_radii and keep the best (BIC);
   /// false holds setup.clusters.radius_factor.
@@ -86,6 +88,9 @@ struct BaselineChoice {
   double cluster_radius_factor(double fallback) const {
     return candidates.empty() ? fallback : candidates[static_cast<std::size_t>(chosen)].cluster_radius_factor;
   }
+  /// The candidates' msm_beta spread (one sd) around the kept one's, each candidate weighted by
+  /// exp(-(bic - bic_kept) / 2); 0 with fewer than two candidates (docs/estimation.md).
+  double msm_beta_spread() const;
 };
 
 /// Human-readable name of a mode ("auto", "fit", "fixed").
@@ -106,9 +111,13 @@ struct EstimateReport {
   double noise_std = 0;                ///< position noise used for the input perturbation
   double msm_beta_std_curvature = 0;   ///< from the error curve alone (core estimator)
   double msm_beta_std_input = 0;       ///< spread of refits under perturbed inputs
-  double msm_beta_std = 0;             ///< combined: sqrt(curvature^2 + input^2)
-  double spacing = 0;                  ///< median nearest-neighbour distance of the rest shape
-  double frame_interval_s = 0;         ///< mean time step used by the simulation
+  /// Spread of msm_beta over the baseline variants fitted (steps per frame, msm_alpha held or
+  /// fitted, cluster radius), each weighted by exp(-(BIC - BIC_kept) / 2), around the kept one's
+  /// value: near-ties between forms that read msm_beta differently widen the uncertainty.
+  double msm_beta_std_model_form = 0;
+  double msm_beta_std = 0;      ///< combined: sqrt(curvature^2 + input^2 + model_form^2)
+  double spacing = 0;           ///< median nearest-neighbour distance of the rest shape
+  double frame_interval_s = 0;  ///< mean time step used by the simulation
   double runtime_s = 0;
 };
 

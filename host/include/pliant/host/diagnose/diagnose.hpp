@@ -51,7 +51,7 @@ struct DiagnoseOptions {
   /// (docs/estimation.md): automatic selection, always fitted, or held at msm_alpha.
   AlphaMode alpha = AlphaMode::automatic;
   double msm_alpha = 1.0;              ///< (0, 1]: the held value
-  int steps_per_frame = 0;             ///< 0: chosen among 1..max_auto_steps_per_frame; else held (1..64)
+  int steps_per_frame = 0;             ///< 0: chosen as estimate chooses it (estimate.hpp); else held (1..64)
   bool cluster_radius_auto = true;     ///< also try auto_cluster_radii (else held)
   double cluster_radius_factor = 1.5;  ///< held value, and the first the automatic choice tries
   int holdout_block_frames = 0;        ///< 0: about a tenth of a second of frames (at least 3)
