@@ -1,6 +1,7 @@
 #include "convert.hpp"
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 namespace pliant::python {

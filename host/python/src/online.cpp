@@ -4,6 +4,7 @@
 // particles, clusters), the recording's driven particles following their observed positions
 // while their windows are active at the frame's recorded time.
 #include <algorithm>
+#include <cstdint>
 #include <memory>
 #include <mutex>
 #include <string>

@@ -61,9 +61,10 @@ host::DrivenWindow driven_window(py::handle item) {
   } else if (py::isinstance<py::tuple>(item) || py::isinstance<py::list>(item)) {
     const py::sequence entry = item.cast<py::sequence>();
     if (entry.size() != 3) throw py::value_error("driven: a tuple entry is (id, from_s, to_s)");
-    window.id = entry[0].cast<int>();
-    if (!entry[1].is_none()) window.from_s = entry[1].cast<double>();
-    if (!entry[2].is_none()) window.to_s = entry[2].cast<double>();
+    const py::object id = entry[std::size_t{0}], from = entry[std::size_t{1}], to = entry[std::size_t{2}];
+    window.id = id.cast<int>();
+    if (!from.is_none()) window.from_s = from.cast<double>();
+    if (!to.is_none()) window.to_s = to.cast<double>();
   } else {
     window.id = item.cast<int>();
   }

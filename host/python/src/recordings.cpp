@@ -108,8 +108,9 @@ py::object mesh_dict(py::handle self) {
   py::dict out;
   out["points"] = double_view(self, mesh.points, {mesh.point_count(), 3});
   out["tetrahedra"] = int_view(self, mesh.tetrahedra, {mesh.tet_count(), 4});
-  out["youngs_modulus"] =
-      mesh.youngs_modulus.empty() ? py::object(py::none()) : double_view(self, mesh.youngs_modulus, {mesh.tet_count()});
+  out["youngs_modulus"] = mesh.youngs_modulus.empty()
+                              ? py::object(py::none())
+                              : py::object(double_view(self, mesh.youngs_modulus, {mesh.tet_count()}));
   return out;
 }
 
@@ -118,7 +119,7 @@ std::string describe(const Recording& r) {
          std::to_string(r.frame_count()) + " frames, " + std::to_string(r.dimension) + "D, " + r.length_unit + ">";
 }
 
-RecordingPtr read(py::handle path_like) {
+RecordingPtr read_from(py::handle path_like) {
   const std::string path = path_of(path_like, "path");
   RecordingPtr recording;
   {
@@ -129,7 +130,7 @@ RecordingPtr read(py::handle path_like) {
   return recording;
 }
 
-void write(py::handle path_like, const Recording& recording) {
+void write_to(py::handle path_like, const Recording& recording) {
   const std::string path = path_of(path_like, "path");
   py::gil_scoped_release release;
   host::write_recording(recording, path);
@@ -235,11 +236,11 @@ void bind_recordings(py::module_& module) {
       .def_property_readonly("files", [](const Recording& r) { return py::cast(r.files); })
       .def_property_readonly("warnings", [](const Recording& r) { return py::cast(r.warnings); })
       .def(
-          "write", [](const Recording& r, py::handle path) { write(path, r); }, py::arg("path"),
+          "write", [](const Recording& r, py::handle path) { write_to(path, r); }, py::arg("path"),
           "Writes the recording as a v1 directory (see write_recording).")
       .def("__repr__", [](const Recording& r) { return describe(r); });
 
-  module.def("read_recording", &read, py::arg("path"),
+  module.def("read_recording", &read_from, py::arg("path"),
              "read_recording(path) -> Recording\n\nReads a recording directory (recording-v1). pliant.InputError "
              "names the file, the line or key, and the cause; the reader's warnings are PliantWarning.");
   module.def(
@@ -249,7 +250,7 @@ void bind_recordings(py::module_& module) {
       },
       py::arg("times"), py::arg("positions"), kMakeDoc);
   module.def(
-      "write_recording", [](py::handle path, const Recording& recording) { write(path, recording); },
+      "write_recording", [](py::handle path, const Recording& recording) { write_to(path, recording); },
       py::arg("path"), py::arg("recording"),
       "write_recording(path, recording)\nwrite_recording(path, times, positions, **make_recording options)\n\n"
       "Writes a recording directory (created if needed; files of the same names replaced, each through a "
@@ -258,7 +259,7 @@ void bind_recordings(py::module_& module) {
       "write_recording",
       [](py::handle path, py::object times, py::object positions, const py::kwargs& options) {
         const RecordingPtr recording = recording_from_arrays(arrays_of(std::move(times), std::move(positions), options));
-        write(path, *recording);
+        write_to(path, *recording);
         return recording;
       },
       py::arg("path"), py::arg("times"), py::arg("positions"));
