@@ -52,7 +52,7 @@ host::ScenarioOptions scenario_options(const SimulateJob& job) {
 
 host::ScenarioResult run_simulate_job(const SimulateJob& job) {
   host::ScenarioOptions options = scenario_options(job);
-  if (!job.output.empty()) check_output_directory(job.output, job.force);
+  if (job.output) check_output_directory(*job.output, job.force);
   host::ScenarioResult scenario;
   try {
     if (job.effect) host::parse_effect_argument(*job.effect, options);
@@ -61,14 +61,14 @@ host::ScenarioResult run_simulate_job(const SimulateJob& job) {
     // make_scenario validates the scenario name, the option values and the effect.
     throw UsageError(e.what());
   }
-  if (!job.output.empty()) host::write_scenario(scenario, job.output);
+  if (job.output) host::write_scenario(scenario, *job.output);
   return scenario;
 }
 
 std::string simulate_summary(const SimulateJob& job, const host::ScenarioResult& scenario) {
   const host::Recording& rec = scenario.recording;
   // The summary names what is visible in the recording; the effect stays in truth.json.
-  return "wrote " + job.output + ": " + job.scenario + ", " + std::to_string(rec.particle_count) + " particles x " +
+  return "wrote " + job.output.value_or("") + ": " + job.scenario + ", " + std::to_string(rec.particle_count) + " particles x " +
          std::to_string(rec.frame_count()) + " frames (" + std::to_string(rec.dimension) + "D, " + rec.length_unit +
          "), msm_beta " + number(job.options.msm_beta) + ", msm_alpha " + number(job.options.msm_alpha) + ", noise " +
          number(job.options.noise) + ", seed " + std::to_string(job.options.seed) + "; truth in truth.json\n";

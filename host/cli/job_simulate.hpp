@@ -12,7 +12,7 @@ namespace pliant::cli {
 /// value" when zero (rate, depth) are empty optionals when not given.
 struct SimulateJob {
   std::string scenario;          ///< SCENARIO, one of host::scenario_names()
-  std::string output;            ///< -o DIR; "" writes nothing (the Python module's in-memory run)
+  std::optional<std::string> output;  ///< -o DIR; empty: nothing written (the Python module's in-memory run)
   host::ScenarioOptions options;  ///< --beta, --alpha, --noise, --seed, --substeps, --cluster-radius, --occlusion, --release
   std::optional<double> rate;    ///< --rate HZ, > 0 and at most 10 kHz
   std::optional<double> depth;   ///< --depth F, in (0, 2]

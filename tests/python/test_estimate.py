@@ -33,7 +33,7 @@ def test_numbers_stand_for_the_options_text(examples, tmp_path):
 
 def test_another_thread_runs_during_an_estimate(examples):
     """The estimate releases the GIL: a Python loop keeps running beside it, with no long stall."""
-    rec = pliant.read_recording(examples / "foam_press_medium")
+    rec = pliant.read_recording(examples / "block_press")
     sys.setswitchinterval(0.001)
     worker = threading.Thread(target=pliant.estimate, args=(rec,), kwargs={"quiet": True})
     started = time.perf_counter()

@@ -194,7 +194,8 @@ None to pass the previous one again:
   wrench       {'stamp', 'wrench' (6,) Fx Fy Fz N Tx Ty Tz N m, 'status', 'valid', 'bus_off', 'timeout'}
   deformation  {'stamp', 'strain', 'status', 'valid', 'bus_off', 'timeout'}
   estimate     {'stamp', 'msm_beta', 'msm_beta_std', 'valid'}
-Keys left out keep their previous values; a dict given is valid unless 'valid': False. Returns
+In a dict, 'valid' defaults to True, 'bus_off' and 'timeout' to False; other keys left out keep
+their previous values. Returns
 GraspGuardOutput as a dict: 'verdict' ('ok', 'limit', 'stop'), 'reason', 'stop_action',
 'reasons', 'fault_sources', 'in_contact', 'slip', and the numbers with their units in their
 names (closure_m, safe_width_m, allowed_force_n, ...).)doc";

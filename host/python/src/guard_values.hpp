@@ -15,8 +15,8 @@ namespace pliant::python {
 /// ValueError for an unknown name, TypeError for a value of the wrong type.
 GraspGuardConfig guard_config(const py::dict& options);
 
-/// Updates a sample from a dict (keys: see docs/python.md); keys left out keep their values.
-/// A dict given marks the sample valid unless it says 'valid': False.
+/// Updates a sample from a dict (keys: see docs/python.md): 'valid' defaults to True, 'bus_off'
+/// and 'timeout' to False; other keys left out keep their values.
 void read_sample(py::handle value, GripperSample& sample);
 void read_sample(py::handle value, WrenchSample& sample);
 void read_sample(py::handle value, DeformationSample& sample);

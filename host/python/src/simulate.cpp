@@ -30,7 +30,7 @@ cli::SimulateJob simulate_job(const SimulateArguments& a) {
   if (a.seed < 0) throw cli::UsageError("--seed must be >= 0");
   cli::SimulateJob job;
   job.scenario = a.scenario;
-  job.output = optional_path(a.output, "output");
+  if (!a.output.is_none()) job.output = path_of(a.output, "output");
   job.options.msm_beta = a.beta;
   job.options.msm_alpha = a.alpha;
   job.options.noise = a.noise;
