@@ -14,11 +14,11 @@ namespace pliant::cli {
 
 /// The options of `pliant diagnose`, by their long names.
 struct DiagnoseJob {
-  std::string json;          ///< --json OUT: also write the document there; "" or "-": no file
-  std::string report;        ///< --report DIR: write DIR/index.html; "": no report
+  std::string json;           ///< --json OUT: also write the document there; "" or "-": no file
+  std::string report;         ///< --report DIR: write DIR/index.html; "": no report
   std::string model = "msm";  ///< --model msm|fem
-  ModelFormText model_form;  ///< the msm baseline's form; --model fem takes none of it
-  bool progress = false;     ///< a progress bar on stderr (only on a terminal)
+  ModelFormText model_form;   ///< the msm baseline's form; --model fem takes none of it
+  bool progress = false;      ///< a progress bar on stderr (only on a terminal)
 };
 
 struct DiagnoseDone {

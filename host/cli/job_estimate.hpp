@@ -13,11 +13,11 @@ namespace pliant::cli {
 
 /// The options of `pliant estimate`, by their long names.
 struct EstimateJob {
-  std::string json;                  ///< --json OUT: also write the document there; "" or "-": no file
-  std::string mode = "trajectory";   ///< --mode final|trajectory
-  ModelFormText model_form;          ///< --alpha, --msm-alpha, --steps-per-frame, --cluster-radius
-  int grid = 11;                     ///< --grid N, 3..1001
-  bool progress = false;             ///< a progress bar on stderr (only on a terminal)
+  std::string json;                 ///< --json OUT: also write the document there; "" or "-": no file
+  std::string mode = "trajectory";  ///< --mode final|trajectory
+  ModelFormText model_form;         ///< --alpha, --msm-alpha, --steps-per-frame, --cluster-radius
+  int grid = 11;                    ///< --grid N, 3..1001
+  bool progress = false;            ///< a progress bar on stderr (only on a terminal)
 };
 
 struct EstimateDone {

@@ -34,10 +34,10 @@ struct RefineJob {
 };
 
 struct RefineDone {
-  nlohmann::json card;          ///< the material card (pliant-material v1)
-  std::string summary;          ///< what the command prints (refine_summary)
-  std::string rest_mesh;        ///< the rest mesh written ("" without rest_shape)
-  std::string vtk_collection;   ///< the .pvd written ("" without --vtk)
+  nlohmann::json card;         ///< the material card (pliant-material v1)
+  std::string summary;         ///< what the command prints (refine_summary)
+  std::string rest_mesh;       ///< the rest mesh written ("" without rest_shape)
+  std::string vtk_collection;  ///< the .pvd written ("" without --vtk)
 };
 
 /// Checks the options, takes the recording from `source` (its warnings, and options that do not

@@ -68,10 +68,11 @@ host::ScenarioResult run_simulate_job(const SimulateJob& job) {
 std::string simulate_summary(const SimulateJob& job, const host::ScenarioResult& scenario) {
   const host::Recording& rec = scenario.recording;
   // The summary names what is visible in the recording; the effect stays in truth.json.
-  return "wrote " + job.output.value_or("") + ": " + job.scenario + ", " + std::to_string(rec.particle_count) + " particles x " +
-         std::to_string(rec.frame_count()) + " frames (" + std::to_string(rec.dimension) + "D, " + rec.length_unit +
-         "), msm_beta " + number(job.options.msm_beta) + ", msm_alpha " + number(job.options.msm_alpha) + ", noise " +
-         number(job.options.noise) + ", seed " + std::to_string(job.options.seed) + "; truth in truth.json\n";
+  return "wrote " + job.output.value_or("") + ": " + job.scenario + ", " + std::to_string(rec.particle_count) +
+         " particles x " + std::to_string(rec.frame_count()) + " frames (" + std::to_string(rec.dimension) + "D, " +
+         rec.length_unit + "), msm_beta " + number(job.options.msm_beta) + ", msm_alpha " +
+         number(job.options.msm_alpha) + ", noise " + number(job.options.noise) + ", seed " +
+         std::to_string(job.options.seed) + "; truth in truth.json\n";
 }
 
 }  // namespace pliant::cli

@@ -11,13 +11,14 @@ namespace pliant::cli {
 /// The options of `pliant simulate`, by their long names. Options a scenario reads as "its own
 /// value" when zero (rate, depth) are empty optionals when not given.
 struct SimulateJob {
-  std::string scenario;          ///< SCENARIO, one of host::scenario_names()
+  std::string scenario;               ///< SCENARIO, one of host::scenario_names()
   std::optional<std::string> output;  ///< -o DIR; empty: nothing written (the Python module's in-memory run)
-  host::ScenarioOptions options;  ///< --beta, --alpha, --noise, --seed, --substeps, --cluster-radius, --occlusion, --release
-  std::optional<double> rate;    ///< --rate HZ, > 0 and at most 10 kHz
-  std::optional<double> depth;   ///< --depth F, in (0, 2]
+  /// --beta, --alpha, --noise, --seed, --substeps, --cluster-radius, --occlusion, --release
+  host::ScenarioOptions options;
+  std::optional<double> rate;         ///< --rate HZ, > 0 and at most 10 kHz
+  std::optional<double> depth;        ///< --depth F, in (0, 2]
   std::optional<std::string> effect;  ///< --effect NAME[:P=V,...]
-  bool force = false;            ///< --force: write into a non-empty DIR
+  bool force = false;                 ///< --force: write into a non-empty DIR
 };
 
 /// Checks the options, simulates, and writes the recording and truth.json into job.output.

@@ -23,8 +23,8 @@ bool parse_number(const std::string& text, double& value) {
 int steps_per_frame_of(const std::string& text) {
   double steps = 0;
   if (!parse_number(text, steps) || steps != std::floor(steps) || steps < 1 || steps > max_steps_per_frame) {
-    throw UsageError("--steps-per-frame must be 'auto' or a whole number in 1.." +
-                     std::to_string(max_steps_per_frame) + ", not '" + text + "'");
+    throw UsageError("--steps-per-frame must be 'auto' or a whole number in 1.." + std::to_string(max_steps_per_frame) +
+                     ", not '" + text + "'");
   }
   return static_cast<int>(steps);
 }

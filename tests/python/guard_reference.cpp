@@ -70,7 +70,8 @@ std::vector<Vec> squeezed(const std::vector<double>& rest, double closure) {
   const double stretch = 1.0 - closure / kContact;
   const double bulge = 1.0 / std::sqrt(stretch);
   std::vector<Vec> out;
-  for (std::size_t i = 0; i < rest.size(); i += 3) out.emplace_back(rest[i] * stretch, rest[i + 1] * bulge, rest[i + 2] * bulge);
+  for (std::size_t i = 0; i < rest.size(); i += 3)
+    out.emplace_back(rest[i] * stretch, rest[i + 1] * bulge, rest[i + 2] * bulge);
   return out;
 }
 

@@ -26,8 +26,7 @@ void require_shape(const py::array& array, const char* what, const std::vector<p
     wanted += (axis > 0 ? ", " : "") + (shape[axis] < 0 ? std::string("any") : std::to_string(shape[axis]));
   }
   wanted += shape.size() == 1 ? ",)" : ")";
-  throw py::value_error(std::string(what) + " must have shape " + axes + " = " + wanted + ", not " +
-                        shape_text(array));
+  throw py::value_error(std::string(what) + " must have shape " + axes + " = " + wanted + ", not " + shape_text(array));
 }
 
 // `value` as a NumPy array without conversion (None and non-sequences refused).

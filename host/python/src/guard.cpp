@@ -175,7 +175,8 @@ GuardSetup guard_setup(py::handle rest_positions, py::handle squeeze_axis, py::h
   return setup;
 }
 
-const char* kDoc = R"doc(GraspGuard(rest_positions, squeeze_axis, *, jaw_a=None, jaw_b=None, contact_band=0.25, **config)
+const char* kDoc =
+    R"doc(GraspGuard(rest_positions, squeeze_axis, *, jaw_a=None, jaw_b=None, contact_band=0.25, **config)
 
 The controller's grasp guard (docs/grasp_guard.md) on an object given by its rest particles:
 rest_positions (n_particles, dim) in m, in the object's frame at first contact; squeeze_axis

@@ -80,7 +80,8 @@ double real(py::handle value, const std::string& what) {
 }
 
 long long whole(py::handle value, const std::string& what) {
-  if (py::isinstance<py::bool_>(value) || !py::isinstance<py::int_>(value)) throw py::type_error(what + " must be an int");
+  if (py::isinstance<py::bool_>(value) || !py::isinstance<py::int_>(value))
+    throw py::type_error(what + " must be an int");
   return value.cast<long long>();
 }
 
@@ -239,7 +240,8 @@ py::dict output_dict(const GraspGuardOutput& o) {
   }
   py::list fault_sources;
   for (int s = 0; s < kGuardSourceCount; ++s) {
-    if ((static_cast<unsigned>(o.fault_sources) & (1u << s)) != 0) fault_sources.append(guard_source_name(static_cast<GuardSource>(s)));
+    if ((static_cast<unsigned>(o.fault_sources) & (1u << s)) != 0)
+      fault_sources.append(guard_source_name(static_cast<GuardSource>(s)));
   }
   py::dict out;
   out["verdict"] = grasp_verdict_name(o.verdict);

@@ -43,8 +43,8 @@ class EstimatorOf final : public Estimator {
     model_ = host::build_msm_model<Dim>(*recording_, host::MsmSetupOptions{});
     workspace_.resize(online_deformability_workspace_size(model_->model, config));
     Arena arena(workspace_.data(), workspace_.size());
-    host::require_ok(online_deformability_init(arena, model_->model,
-                                               host::base_params<Dim>(*recording_, msm_alpha), config, online_),
+    host::require_ok(online_deformability_init(arena, model_->model, host::base_params<Dim>(*recording_, msm_alpha),
+                                               config, online_),
                      "online estimator");
     const auto n = static_cast<std::size_t>(recording_->particle_count);
     observed_.assign(n, Vec::Zero());
@@ -97,8 +97,7 @@ struct OnlineSettings {
 OnlineDeformabilityConfig online_config(const OnlineSettings& s) {
   if (s.candidates < 3) throw cli::UsageError("the online estimator needs at least 3 candidates");
   if (s.alpha_candidates < 1 || s.alpha_candidates > kMaxOnlineAlphaRows) {
-    throw cli::UsageError("the online estimator takes 1 to " + std::to_string(kMaxOnlineAlphaRows) +
-                          " msm_alpha rows");
+    throw cli::UsageError("the online estimator takes 1 to " + std::to_string(kMaxOnlineAlphaRows) + " msm_alpha rows");
   }
   if (s.step_candidates < 1 || s.step_candidates > kMaxOnlineStepRows) {
     throw cli::UsageError("the online estimator takes 1 to " + std::to_string(kMaxOnlineStepRows) +

@@ -14,8 +14,8 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // times (n_frames,), positions (n_frames, n_particles, dim) with unobserved entries NaN or
 // masked out by `observed` (n_frames, n_particles).
 void fill_frames(const RecordingArrays& arrays, host::Recording& r) {
-  const py::array_t<double> positions = real_array(arrays.positions, "positions", {-1, -1, -1},
-                                                   "(n_frames, n_particles, dim)");
+  const py::array_t<double> positions =
+      real_array(arrays.positions, "positions", {-1, -1, -1}, "(n_frames, n_particles, dim)");
   const py::ssize_t frames = positions.shape(0);
   const py::ssize_t particles = positions.shape(1);
   const py::ssize_t dim = positions.shape(2);
@@ -28,8 +28,8 @@ void fill_frames(const RecordingArrays& arrays, host::Recording& r) {
   r.frame_times_s.assign(times.data(), times.data() + frames);
   r.positions.assign(positions.data(), positions.data() + positions.size());
   if (arrays.observed.is_none()) return;
-  const py::array_t<bool> observed = bool_array(arrays.observed, "observed", {frames, particles},
-                                                "(n_frames, n_particles)");
+  const py::array_t<bool> observed =
+      bool_array(arrays.observed, "observed", {frames, particles}, "(n_frames, n_particles)");
   const bool* seen = observed.data();
   for (py::ssize_t k = 0; k < frames * particles; ++k) {
     if (seen[k]) continue;
@@ -137,8 +137,8 @@ void fill_mesh(const RecordingArrays& arrays, host::Recording& r) {
   }
   tet.tetrahedra = id_list(tetrahedra.attr("reshape")(-1), "mesh['tetrahedra']");
   if (mesh.contains("youngs_modulus") && !mesh["youngs_modulus"].is_none()) {
-    const py::array_t<double> e = real_array(mesh["youngs_modulus"], "mesh['youngs_modulus']",
-                                             {tetrahedra.shape(0)}, "(n_tetrahedra,)");
+    const py::array_t<double> e =
+        real_array(mesh["youngs_modulus"], "mesh['youngs_modulus']", {tetrahedra.shape(0)}, "(n_tetrahedra,)");
     tet.youngs_modulus.assign(e.data(), e.data() + e.size());
   }
   r.mesh = std::move(tet);

@@ -140,9 +140,10 @@ RecordingArrays arrays_of(py::object times, py::object positions, const py::kwar
   RecordingArrays arrays;
   arrays.times = std::move(times);
   arrays.positions = std::move(positions);
-  py::object* fields[] = {&arrays.observed, &arrays.masses, &arrays.fixed,   &arrays.driven,   &arrays.gravity,
-                          &arrays.wrench,   &arrays.gripper, &arrays.mesh,   &arrays.material, &arrays.meta};
-  const char* names[] = {"observed", "masses", "fixed", "driven", "gravity", "wrench", "gripper", "mesh", "material", "meta"};
+  py::object* fields[] = {&arrays.observed, &arrays.masses,  &arrays.fixed, &arrays.driven,   &arrays.gravity,
+                          &arrays.wrench,   &arrays.gripper, &arrays.mesh,  &arrays.material, &arrays.meta};
+  const char* names[] = {"observed", "masses",  "fixed", "driven",   "gravity",
+                         "wrench",   "gripper", "mesh",  "material", "meta"};
   for (py::object* field : fields) *field = py::none();
   for (const auto& item : options) {
     const std::string key = item.first.cast<std::string>();
@@ -191,9 +192,12 @@ ValueError and TypeError; the recording's rules: pliant.InputError.)doc";
 
 void bind_recordings(py::module_& module) {
   py::class_<Recording, RecordingPtr>(module, "Recording", kRecordingDoc)
-      .def_property_readonly("name", [](const Recording& r) { return r.name; }, "directory base name")
-      .def_property_readonly("dimension", [](const Recording& r) { return r.dimension; }, "2 or 3")
-      .def_property_readonly("length_unit", [](const Recording& r) { return r.length_unit; }, "'m' or 'px'")
+      .def_property_readonly(
+          "name", [](const Recording& r) { return r.name; }, "directory base name")
+      .def_property_readonly(
+          "dimension", [](const Recording& r) { return r.dimension; }, "2 or 3")
+      .def_property_readonly(
+          "length_unit", [](const Recording& r) { return r.length_unit; }, "'m' or 'px'")
       .def_property_readonly("particle_count", [](const Recording& r) { return r.particle_count; })
       .def_property_readonly("frame_count", [](const Recording& r) { return r.frame_count(); })
       .def_property_readonly(
@@ -224,8 +228,7 @@ void bind_recordings(py::module_& module) {
       .def_property_readonly("driven", &driven_list,
                              "[{'id', 'from', 'to'}]: particles following their observations while from <= t <= to")
       .def_property_readonly(
-          "gravity",
-          [](const Recording& r) { return r.gravity ? py::cast(*r.gravity) : py::object(py::none()); },
+          "gravity", [](const Recording& r) { return r.gravity ? py::cast(*r.gravity) : py::object(py::none()); },
           "[dim components] length_unit/s^2, or None when not declared")
       .def_property_readonly("wrench", &wrench_dict,
                              "{'times', 'force' (m, 3) N, 'torque' (m, 3) N m, 'applied_to'} or None")
@@ -258,7 +261,8 @@ void bind_recordings(py::module_& module) {
   module.def(
       "write_recording",
       [](py::handle path, py::object times, py::object positions, const py::kwargs& options) {
-        const RecordingPtr recording = recording_from_arrays(arrays_of(std::move(times), std::move(positions), options));
+        const RecordingPtr recording =
+            recording_from_arrays(arrays_of(std::move(times), std::move(positions), options));
         write_to(path, *recording);
         return recording;
       },

@@ -84,8 +84,8 @@ void bind_refine(py::module_& module) {
       [](py::handle recording, py::handle mesh, py::handle estimate, const std::string& estimator,
          const std::string& volumetric, py::handle json, py::handle vtk, std::optional<double> max_strain,
          bool no_force_offset, std::optional<double> initial_modulus, py::handle control_points,
-         std::optional<int> rest_frame, py::handle rest_mesh, std::optional<double> until,
-         std::optional<int> substeps, int threads, bool quiet) {
+         std::optional<int> rest_frame, py::handle rest_mesh, std::optional<double> until, std::optional<int> substeps,
+         int threads, bool quiet) {
         RefineArguments a;
         a.recording = recording;
         a.mesh = mesh;
