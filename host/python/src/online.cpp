@@ -1,8 +1,6 @@
 // pliant.OnlineEstimator: the core's online msm_beta estimator (pliant/core/online_deformability.hpp)
-// on a recording's model, stepped frame by frame with NumPy arrays, exactly as `pliant replay`
-// steps it (host/src/replay/replay_session.cpp): the model from the recording (rest shape, fixed
-// particles, clusters), the recording's driven particles following their observed positions
-// while their windows are active at the frame's recorded time.
+// on a recording's model, stepped frame by frame with NumPy arrays: the estimator `pliant replay`
+// steps (pliant/host/replay/online_estimator.hpp), which owns the core's fixed memory.
 #include <algorithm>
 #include <cstdint>
 #include <memory>
@@ -13,76 +11,12 @@
 #include "bindings.hpp"
 #include "convert.hpp"
 #include "exit_status.hpp"
-#include "pliant/core/arena.hpp"
 #include "pliant/core/online_deformability.hpp"
-#include "pliant/host/msm_setup.hpp"
 #include "pliant/host/recording.hpp"
+#include "pliant/host/replay/online_estimator.hpp"
 
 namespace pliant::python {
 namespace {
-
-/// The estimator of one dimension, in memory this wrapper owns.
-class Estimator {
- public:
-  virtual ~Estimator() = default;
-  /// positions: [particle_count * Dim], NaN unobserved. Returns the core's status.
-  virtual Status update(double t_s, double dt_s, const double* positions) = 0;
-  virtual OnlineDeformabilityEstimate estimate() const = 0;
-  virtual void reset() = 0;
-  virtual std::uint32_t rejected() const = 0;
-  virtual std::uint32_t empty() const = 0;
-};
-
-template <int Dim>
-class EstimatorOf final : public Estimator {
- public:
-  using Vec = Eigen::Matrix<double, Dim, 1>;
-  EstimatorOf(std::shared_ptr<const host::Recording> recording, const OnlineDeformabilityConfig& config,
-              double msm_alpha)
-      : recording_(std::move(recording)) {
-    model_ = host::build_msm_model<Dim>(*recording_, host::MsmSetupOptions{});
-    workspace_.resize(online_deformability_workspace_size(model_->model, config));
-    Arena arena(workspace_.data(), workspace_.size());
-    host::require_ok(online_deformability_init(arena, model_->model, host::base_params<Dim>(*recording_, msm_alpha),
-                                               config, online_),
-                     "online estimator");
-    const auto n = static_cast<std::size_t>(recording_->particle_count);
-    observed_.assign(n, Vec::Zero());
-    driven_ids_.reserve(n);
-    driven_targets_.reserve(n);
-  }
-
-  Status update(double t_s, double dt_s, const double* positions) override {
-    for (std::size_t i = 0; i < observed_.size(); ++i) {
-      for (int d = 0; d < Dim; ++d) observed_[i](d) = positions[i * Dim + static_cast<std::size_t>(d)];
-    }
-    driven_ids_.clear();
-    driven_targets_.clear();
-    for (const host::DrivenWindow& window : recording_->driven) {
-      const Vec& p = observed_[static_cast<std::size_t>(window.id)];
-      if (!window.active_at(t_s) || !p.allFinite()) continue;
-      if (std::find(driven_ids_.begin(), driven_ids_.end(), window.id) != driven_ids_.end()) continue;
-      driven_ids_.push_back(window.id);
-      driven_targets_.push_back(p);
-    }
-    const MsmDrivenTargets<Dim, double> driven{driven_ids_.data(), driven_targets_.data(),
-                                               static_cast<int>(driven_ids_.size())};
-    return online_deformability_update(model_->model, online_, dt_s, driven, observed_.data());
-  }
-  OnlineDeformabilityEstimate estimate() const override { return online_deformability_estimate(online_); }
-  void reset() override { online_deformability_reset(model_->model, online_); }
-  std::uint32_t rejected() const override { return online_.rejected_frames; }
-  std::uint32_t empty() const override { return online_.empty_frames; }
-
- private:
-  std::shared_ptr<const host::Recording> recording_;
-  std::unique_ptr<host::HostMsmModel<Dim>> model_;
-  std::vector<unsigned char> workspace_;  // the core estimator's memory, carved once
-  OnlineDeformability<Dim, double> online_;
-  std::vector<Vec> observed_;
-  std::vector<int> driven_ids_;
-  std::vector<Vec> driven_targets_;
-};
 
 struct OnlineSettings {
   int candidates = 21;
@@ -135,15 +69,10 @@ py::dict estimate_dict(const OnlineDeformabilityEstimate& e) {
 class OnlineEstimator {
  public:
   OnlineEstimator(const std::shared_ptr<host::Recording>& recording, const OnlineSettings& settings)
-      : particle_count_(recording->particle_count), dimension_(recording->dimension) {
+      : recording_(recording), particle_count_(recording->particle_count), dimension_(recording->dimension) {
     const OnlineDeformabilityConfig config = online_config(settings);
-    const std::shared_ptr<const host::Recording> shared = recording;
-    py::gil_scoped_release release;  // init relaxes nothing but carves and resets every candidate
-    if (dimension_ == 2) {
-      estimator_ = std::make_unique<EstimatorOf<2>>(shared, config, settings.msm_alpha);
-    } else {
-      estimator_ = std::make_unique<EstimatorOf<3>>(shared, config, settings.msm_alpha);
-    }
+    py::gil_scoped_release release;  // builds the model and carves and resets every candidate
+    estimator_ = std::make_unique<host::OnlineRecordingEstimator>(*recording_, config, settings.msm_alpha);
   }
 
   py::dict update(double t_s, double dt_s, py::handle positions) {
@@ -154,7 +83,7 @@ class OnlineEstimator {
     {
       py::gil_scoped_release release;
       const std::lock_guard<std::mutex> lock(mutex_);
-      status = estimator_->update(t_s, dt_s, frame.data());
+      status = estimator_->update(frame.data(), t_s, dt_s);
       after = estimator_->estimate();
     }
     py::dict out = estimate_dict(after);
@@ -176,18 +105,19 @@ class OnlineEstimator {
   int dimension() const { return dimension_; }
   std::uint32_t rejected() {
     const std::lock_guard<std::mutex> lock(mutex_);
-    return estimator_->rejected();
+    return estimator_->rejected_frames();
   }
   std::uint32_t empty() {
     const std::lock_guard<std::mutex> lock(mutex_);
-    return estimator_->empty();
+    return estimator_->empty_frames();
   }
 
  private:
+  std::shared_ptr<const host::Recording> recording_;  // the estimator reads its driven windows
   int particle_count_;
   int dimension_;
   std::mutex mutex_;
-  std::unique_ptr<Estimator> estimator_;
+  std::unique_ptr<host::OnlineRecordingEstimator> estimator_;
 };
 
 const char* kDoc = R"doc(OnlineEstimator(recording, *, candidates=21, alpha_candidates=3, step_candidates=3,
