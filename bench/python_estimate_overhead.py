@@ -1,6 +1,6 @@
 """The Python call's overhead on `estimate` of the paper's 4 x 8 press (budget: 10 %).
 
-Times pliant.estimate(recording) on examples/foam_press_medium (32 particles, 121 frames, the
+Times pliant.estimate(recording) on examples/foam_press_medium (32 particles, 136 frames, the
 recording read once and passed in memory) against the same job called from C++
 (estimate_call_bench), in alternating rounds so that both see the same machine load, and prints
 the fastest call of each and the overhead. Exit status 1 when the overhead is above the budget
