@@ -6,9 +6,11 @@
 #   libpliant-dev       host_dev   the host libraries, vision and the drivers that were built,
 #                                  with their headers and CMake component scripts
 #   pliant              cli        the `pliant` command line
+#   python3-pliant      python     the Python module pliant (host/python) in
+#                                  /usr/lib/python3/dist-packages/pliant
 # The libraries are static, so the -dev packages depend on the -dev packages a consumer links
-# against (the list below follows what was built); the program's run-time dependencies are read
-# off the binary by dpkg-shlibdeps.
+# against (the list below follows what was built); the program's and the Python extension's
+# run-time dependencies are read off the binaries by dpkg-shlibdeps.
 # Usage: cmake --build build && (cd build && cpack -G DEB)   or   bash tools/test.sh package
 set(CPACK_PACKAGE_NAME pliant)
 set(CPACK_PACKAGE_VENDOR "pliant")
@@ -61,6 +63,24 @@ set(CPACK_DEBIAN_CLI_PACKAGE_NAME pliant)
 set(CPACK_DEBIAN_CLI_PACKAGE_SHLIBDEPS ON)
 set(CPACK_COMPONENT_CLI_DESCRIPTION "the pliant command line: estimate, diagnose, refine, simulate, record, replay")
 
+# The extension is built for one Python (its file name carries the ABI, cpython-311-...), so the
+# package wants that minor version; the host libraries are linked into it, so it needs no other
+# pliant package. Its destination is relative (host/python/CMakeLists.txt), so CPack's prefix /usr
+# puts it in /usr/lib/python3/dist-packages/pliant whatever CMAKE_INSTALL_PREFIX the build has.
+set(CPACK_DEBIAN_PYTHON_PACKAGE_NAME python3-pliant)
+set(CPACK_DEBIAN_PYTHON_PACKAGE_SECTION python)
+set(CPACK_DEBIAN_PYTHON_PACKAGE_SHLIBDEPS ON)
+if(PLIANT_PYTHON_VERSION)
+  string(REPLACE "." ";" pliant_python_version_parts "${PLIANT_PYTHON_VERSION}")
+  list(GET pliant_python_version_parts 0 pliant_python_major)
+  list(GET pliant_python_version_parts 1 pliant_python_minor)
+  math(EXPR pliant_python_next_minor "${pliant_python_minor} + 1")
+  set(CPACK_DEBIAN_PYTHON_PACKAGE_DEPENDS
+      "python3 (>= ${PLIANT_PYTHON_VERSION}), python3 (<< ${pliant_python_major}.${pliant_python_next_minor}), python3-numpy")
+endif()
+set(CPACK_COMPONENT_PYTHON_DESCRIPTION
+    "pliant for Python: recordings as NumPy arrays, estimate, diagnose, refine, simulate, online estimator, grasp guard")
+
 # host_dev holds the host libraries and every driver built; a build without either has no
 # libpliant-dev (a controller-only build).
 set(CPACK_COMPONENTS_ALL core_dev)
@@ -78,6 +98,9 @@ if(pliant_has_host_dev)
 endif()
 if(PLIANT_BUILD_HOST AND TARGET pliant)
   list(APPEND CPACK_COMPONENTS_ALL cli)
+endif()
+if(TARGET _pliant)
+  list(APPEND CPACK_COMPONENTS_ALL python)
 endif()
 
 include(CPack)

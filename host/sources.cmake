@@ -88,4 +88,5 @@ set(PLIANT_TELEMETRY_SOURCES
 # a recording played through the HAL replay devices with the online estimate (replay/*.hpp)
 set(PLIANT_REPLAY_SOURCES
   ${pliant_host_src}/replay/replay_channels.cpp
+  ${pliant_host_src}/replay/online_estimator.cpp
   ${pliant_host_src}/replay/replay_session.cpp)

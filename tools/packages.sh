@@ -6,7 +6,9 @@
 #   3. libpliant-core-dev alone, unpacked into an empty root, is enough to build and run the
 #      core consumer (tests/install_consumer) with find_package(pliant);
 #   4. every package unpacked into another empty root: the consumer with every component the
-#      build made, and the unpacked `pliant` program estimating a bundled recording.
+#      build made, and the unpacked `pliant` program estimating a bundled recording;
+#   5. python3-pliant alone, unpacked into an empty root: Debian's python3 imports the module from
+#      its usr/lib/python3/dist-packages and estimates a bundled recording.
 # Usage: bash tools/packages.sh [BUILD_DIR] [OUT_DIR]   (defaults: build, build/packages)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -82,4 +84,25 @@ echo "packages: all packages build and run the consumer with: core ${components[
 if [ -x "$work/all-root/usr/bin/pliant" ]; then
   "$work/all-root/usr/bin/pliant" estimate "$root/examples/foam_press_medium" > "$work/estimate.txt"
   echo "packages: the packaged pliant estimates examples/foam_press_medium: $(grep -m1 msm_beta "$work/estimate.txt")"
+fi
+
+# 5. The Python module alone (the host libraries are linked into it).
+python_deb=$(ls "$out"/python3-pliant_*.deb 2> /dev/null || true)
+if [ -n "$python_deb" ]; then
+  dpkg-deb -x "$python_deb" "$work/python-root"
+  site=$work/python-root/usr/lib/python3/dist-packages
+  [ -f "$site/pliant/__init__.py" ] || { echo "packages: python3-pliant has no usr/lib/python3/dist-packages/pliant" >&2; exit 1; }
+  (cd "$work" && PYTHONPATH=$site PYTHONDONTWRITEBYTECODE=1 /usr/bin/python3 -c '
+import sys
+
+import pliant
+
+site, recording = sys.argv[1], sys.argv[2]
+assert pliant.__file__.startswith(site), pliant.__file__
+document = pliant.estimate(recording, quiet=True)
+print("msm_beta %.3f +- %.3f" % (document["parameters"]["msm_beta"], document["uncertainty"]["msm_beta"]))
+' "$site" "$root/examples/foam_press_medium" > "$work/python.txt") || { cat "$work/python.txt" >&2; exit 1; }
+  echo "packages: python3-pliant alone imports pliant and estimates examples/foam_press_medium: $(cat "$work/python.txt")"
+else
+  echo "packages: no python3-pliant (this build has no Python module)"
 fi

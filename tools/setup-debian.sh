@@ -9,6 +9,10 @@ packages=(
   dpkg-dev                       # tools/packages.sh: dpkg-shlibdeps reads the program's run-time Depends
   clang-format clang-tidy        # tools/lint.sh
   python3                        # tools/lint_tidy.py
+  python3-dev                    # the Python module (host/python): Python's headers
+  pybind11-dev                   # the Python module: C++ bindings
+  python3-numpy                  # the Python module: recordings as NumPy arrays (also tools/concealed/)
+  python3-pytest                 # the Python module's tests (tests/python)
   libeigen3-dev                  # core linear algebra (the only core dependency)
   nlohmann-json3-dev             # recording and result JSON (host)
   libcli11-dev                   # the pliant command line

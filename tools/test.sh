@@ -2,12 +2,14 @@
 # Every test, in stages, each timed:
 #   setup      install what is missing (tools/setup-debian.sh)
 #   release    build everything (Release) and run every test: unit, integration, acceptance,
-#              install consumers
+#              install consumers, the Python module's pytest files (label python)
 #   package    tools/packages.sh: the Debian packages (CPack) from the release build, their
-#              dependencies resolved by apt, and the install consumer built against them unpacked
+#              dependencies resolved by apt, the install consumer built against them unpacked,
+#              and the Python module imported from the unpacked python3-pliant
 #   sanitize   AddressSanitizer + UndefinedBehaviorSanitizer build of what parses outside input or
 #              runs real-time code (PLIANT_SANITIZE_SCOPE=input, see tests/CMakeLists.txt), and
-#              its tests except the slow acceptance runs and the wire HIL's 10-minute soak
+#              its tests except the slow acceptance runs and the wire HIL's 10-minute soak; never
+#              the Python module (an ASan runtime and a Python interpreter do not mix)
 #   cross      tools/cross.sh: the aarch64 tests under qemu, the Cortex-M7 firmware with its
 #              no-allocator check
 #   fuzz       a short libFuzzer smoke run of every parser and decoder (.ci/fuzz_smoke.sh)
@@ -64,7 +66,7 @@ sanitize() {
   # at about half the compile time of -O2 -g on the Eigen-heavy units.
   cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPLIANT_SANITIZE=ON \
     -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" \
-    -DPLIANT_SANITIZE_SCOPE=input -DPLIANT_BUILD_BENCHMARKS=OFF > /dev/null
+    -DPLIANT_SANITIZE_SCOPE=input -DPLIANT_BUILD_BENCHMARKS=OFF -DPLIANT_BUILD_PYTHON=OFF > /dev/null
   cmake --build build-asan -j"$jobs"
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
     ctest --test-dir build-asan -j"$jobs" --output-on-failure -LE 'acceptance|soak' -E install_consumer

@@ -3,12 +3,8 @@
 #include <iostream>
 #include <stdexcept>
 
-#include "atomic_write.hpp"
 #include "exit_status.hpp"
-#include "progress_bar.hpp"
-#include "pliant/host/diagnose/diagnose.hpp"
-#include "pliant/host/diagnose/html_report.hpp"
-#include "pliant/host/recording.hpp"
+#include "job_diagnose.hpp"
 
 namespace pliant::cli {
 
@@ -33,39 +29,17 @@ DiagnoseCommand::DiagnoseCommand(CLI::App& parent) {
 }
 
 int DiagnoseCommand::run() const {
-  if (model_ != "msm" && model_ != "fem") throw UsageError("--model must be msm or fem");
-  host::DiagnoseOptions options;
-  options.model = model_;
-  const ModelFormChoice form = model_form_.apply(*app_);
-  if (model_ == "fem" && ModelFormOptions::given(*app_)) {
-    throw UsageError(
-        "--alpha, --msm-alpha, --steps-per-frame and --cluster-radius shape the msm baseline; "
-        "--model fem takes none of them");
-  }
-  options.alpha = form.alpha;
-  options.msm_alpha = form.msm_alpha;
-  options.steps_per_frame = form.steps_per_frame;
-  options.cluster_radius_auto = form.cluster_radius_auto;
-  options.cluster_radius_factor = form.cluster_radius_factor;
-  const host::Recording recording = host::read_recording(recording_);
-  for (const std::string& warning : recording.warnings) report_warning(warning);
-  if (model_ == "fem" && (recording.dimension != 3 || !recording.mesh || recording.length_unit != "m")) {
-    throw UsageError("--model fem needs a 3D recording in metres with a tetrahedral mesh (mesh.vtk)");
-  }
-
-  host::DiagnoseResult result;
-  {
-    ProgressBar bar("diagnosing", !quiet_);
-    options.progress = [&bar](const std::string&, int done, int total) { bar.update(done, total); };
-    result = host::diagnose_recording(recording, options);
-  }
-  const nlohmann::json document = host::diagnosis_json(result.diagnosis);
-  if (!report_dir_.empty()) host::write_diagnosis_report(result.diagnosis, result.evidence, report_dir_);
+  DiagnoseJob job;
+  job.json = json_path_;
+  job.report = report_dir_;
+  job.model = model_;
+  job.model_form = model_form_.text(*app_);
+  job.progress = !quiet_;
+  const DiagnoseDone done = run_diagnose_job(job, recording_from(recording_), report_warning);
   if (json_path_ == "-") {
-    std::cout << document.dump(2) << '\n';
+    std::cout << done.document.dump(2) << '\n';
   } else {
-    if (!json_path_.empty()) write_file_atomically(json_path_, document.dump(2) + "\n");
-    std::cout << host::diagnosis_summary(result.diagnosis, recording.length_unit);
+    std::cout << host::diagnosis_summary(done.result.diagnosis, done.recording.length_unit);
     if (!json_path_.empty()) std::cout << "wrote " << json_path_ << '\n';
     if (!report_dir_.empty()) std::cout << "wrote " << report_dir_ << "/index.html\n";
   }

@@ -1,80 +1,12 @@
 #include "command_refine.hpp"
 
-#include <unistd.h>
-
-#include <algorithm>
-#include <chrono>
-#include <cmath>
-#include <filesystem>
 #include <iostream>
-#include <limits>
 #include <stdexcept>
-#include <system_error>
-#include <thread>
-#include <vector>
 
-#include "atomic_write.hpp"
 #include "exit_status.hpp"
-#include "pliant/host/fem/fem_recording.hpp"
-#include "pliant/host/fem/material_map.hpp"
-#include "pliant/host/recording.hpp"
-#include "refine_control_points.hpp"
-#include "refine_mesh.hpp"
-#include "refine_output.hpp"
-#include "refine_plan.hpp"
-#include "refine_progress.hpp"
-#include "refine_run.hpp"
+#include "job_refine.hpp"
 
 namespace pliant::cli {
-namespace {
-
-namespace fs = std::filesystem;
-
-fs::path parent_or_current(const fs::path& path) {
-  const fs::path parent = path.parent_path();
-  return parent.empty() ? fs::path(".") : parent;
-}
-
-// Refuses, before any work, an output file that cannot be written: its directory is missing or
-// read-only, or the path is a directory.
-void check_output_file(const std::string& path, const std::string& flag) {
-  std::error_code error;
-  if (fs::is_directory(path, error)) throw UsageError(flag + ": " + path + " is a directory");
-  const fs::path directory = parent_or_current(path);
-  if (!fs::is_directory(directory, error)) {
-    throw UsageError(flag + ": cannot write " + path + ": no such directory " + directory.string());
-  }
-  if (access(directory.c_str(), W_OK) != 0) {
-    throw UsageError(flag + ": cannot write " + path + ": directory " + directory.string() + " is not writable");
-  }
-}
-
-// A directory that exists (and is writable) or can be created under a writable ancestor.
-void check_output_directory(const std::string& path, const std::string& flag) {
-  std::error_code error;
-  fs::path at = fs::absolute(path, error);
-  if (error) throw UsageError(flag + ": bad path " + path);
-  if (fs::exists(at, error) && !fs::is_directory(at, error)) {
-    throw UsageError(flag + ": " + path + " is not a directory");
-  }
-  while (!fs::exists(at, error) && at.has_parent_path() && at.parent_path() != at) at = at.parent_path();
-  if (!fs::is_directory(at, error)) {
-    throw UsageError(flag + ": cannot create " + path + ": " + at.string() + " is not a directory");
-  }
-  if (access(at.c_str(), W_OK) != 0) throw UsageError(flag + ": cannot write into " + at.string());
-}
-
-// What the card names: the rest mesh relative to the card's directory.
-std::string card_reference(const std::string& rest_mesh, const std::string& card) {
-  if (card.empty() || card == "-") return rest_mesh;
-  std::error_code error;
-  const fs::path relative = fs::absolute(rest_mesh, error)
-                                .lexically_normal()
-                                .lexically_relative(fs::absolute(parent_or_current(card), error).lexically_normal());
-  return relative.empty() ? fs::absolute(rest_mesh, error).string() : relative.string();
-}
-
-}  // namespace
 
 RefineCommand::RefineCommand(CLI::App& parent) {
   app_ = parent.add_subcommand(
@@ -153,136 +85,30 @@ RefineCommand::RefineCommand(CLI::App& parent) {
 }
 
 int RefineCommand::run() const {
-  const auto start = std::chrono::steady_clock::now();
-  // Options first: nothing is read or computed for a command that cannot succeed.
-  RefineRequest request;
-  if (app_->count("--estimate") > 0) request = parse_estimate_list(estimate_);
-  if (estimator_ != "auto" && estimator_ != "force" && estimator_ != "reaction" && estimator_ != "trajectory") {
-    throw UsageError("--estimator must be auto, force, reaction or trajectory");
-  }
-  if (volumetric_ != "auto" && volumetric_ != "element" && volumetric_ != "nodal_average") {
-    throw UsageError("--volumetric must be auto, element or nodal_average");
-  }
-  if (!(max_strain_ > 0.0 && max_strain_ <= 1.0)) throw UsageError("--max-strain must be in (0, 1]");
-  if (app_->count("--initial-modulus") > 0 && !(std::isfinite(initial_modulus_pa_) && initial_modulus_pa_ > 0.0)) {
-    throw UsageError("--initial-modulus must be a positive number of Pa");
-  }
-  if (app_->count("--until") > 0 && !std::isfinite(until_s_)) throw UsageError("--until must be a number of seconds");
-  if (substeps_ < 1 || substeps_ > 64) throw UsageError("--substeps must be between 1 and 64");
-  if (threads_ < 0 || threads_ > 256) throw UsageError("--threads must be between 0 and 256");
-  if (rest_frame_ < 0) throw UsageError("--rest-frame must be >= 0");
-  const ControlPointSource control = parse_control_points(control_points_);
-  if (!json_path_.empty() && json_path_ != "-") check_output_file(json_path_, "--json");
-  if (!vtk_dir_.empty()) check_output_directory(vtk_dir_, "--vtk");
-
-  host::Recording recording = host::read_recording(recording_);
-  for (const std::string& warning : recording.warnings) report_warning(warning);
-  std::string mesh_source = "mesh.vtk of the recording";
-  if (!mesh_path_.empty()) {
-    std::vector<std::string> warnings;
-    attach_mesh(recording, mesh_path_, warnings);
-    for (const std::string& warning : warnings) report_warning(warning);
-    mesh_source = mesh_path_;
-  } else if (!recording.mesh) {
-    throw UsageError(
-        "the recording has no mesh (recording.json files.mesh) and no --mesh was given: the FEM needs a "
-        "tetrahedral mesh whose point i is particle i");
-  }
-  host::fem::FemRecordingProblem problem;
-  try {
-    problem = host::fem::fem_problem_from_recording(recording);
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(e.what());
-  }
-  if (app_->count("--until") > 0) host::fem::keep_frames_until(problem, until_s_);
-  if (volumetric_ == "element") problem.material.volumetric = host::fem::FemVolumetric::element;
-  if (volumetric_ == "nodal_average") problem.material.volumetric = host::fem::FemVolumetric::nodal_average;
-
-  const RefinePlan plan = plan_refine(problem, request, estimator_);
-  check_rest_shape(problem, plan, rest_frame_);
-  const bool reaction = plan.estimator && *plan.estimator == RefineEstimator::reaction;
-  const bool trajectory = plan.estimator && *plan.estimator == RefineEstimator::trajectory;
-  if (!reaction && (app_->count("--max-strain") > 0 || no_force_offset_)) {
-    report_warning("--max-strain and --no-force-offset apply to the reaction estimator only; ignored");
-  }
-  if (!trajectory && app_->count("--substeps") > 0) {
-    report_warning("--substeps applies to the trajectory estimator only; ignored");
-  }
-  if (!plan.youngs_modulus && app_->count("--initial-modulus") > 0) {
-    report_warning("--initial-modulus applies when youngs_modulus is estimated; ignored");
-  }
-  if (!plan.estimator && estimator_ != "auto") {
-    report_warning("--estimator: no material parameter to estimate; ignored");
-  }
-  if (!plan.material_map && app_->count("--control-points") > 0) {
-    report_warning("--control-points applies to material_map only; ignored");
-  }
-  if (!plan.rest_shape && (app_->count("--rest-frame") > 0 || app_->count("--rest-mesh") > 0)) {
-    report_warning("--rest-frame and --rest-mesh apply to rest_shape only; ignored");
-  }
-
-  RefineSettings settings;
-  settings.max_strain = max_strain_;
-  settings.force_offset = !no_force_offset_;
-  settings.initial_youngs_modulus_pa = initial_modulus_pa_;
-  settings.rest_frame = rest_frame_;
-  settings.substeps = substeps_;
-  settings.threads = threads_ > 0 ? threads_ : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-  if (plan.material_map) {
-    if (control.count > problem.mesh.tet_count()) {
-      throw UsageError("--control-points " + std::to_string(control.count) + " exceeds the mesh's " +
-                       std::to_string(problem.mesh.tet_count()) + " tetrahedra");
-    }
-    settings.control_point_count = control.count;
-    settings.control_points_m = control.points_m;
-    if (!control.points_m.empty()) {
-      try {
-        const host::fem::MaterialMap check(problem.mesh, control.points_m);
-      } catch (const std::invalid_argument& e) {
-        throw UsageError("--control-points " + control_points_ + ": " + e.what());
-      }
-    }
-  }
-  std::string rest_mesh = rest_mesh_path_;
-  if (plan.rest_shape) {
-    if (rest_mesh.empty()) {
-      rest_mesh = (json_path_.empty() || json_path_ == "-")
-                      ? std::string("rest_shape.vtk")
-                      : (parent_or_current(json_path_) / "rest_shape.vtk").string();
-    }
-    check_output_file(rest_mesh, "--rest-mesh");
-  }
-
-  RefineOutcome outcome;
-  {
-    RefineProgress progress(!quiet_);
-    outcome = run_refine(problem, plan, settings, progress);
-  }
-
-  RefineReport report;
-  report.recording = &recording;
-  report.problem = &problem;
-  report.plan = &plan;
-  report.outcome = &outcome;
-  report.mesh_source = mesh_source;
-  if (plan.rest_shape) report.rest_shape_ref = card_reference(rest_mesh, json_path_);
-  if (!outcome.converged) {
-    report_warning("the fit did not converge" +
-                   (outcome.fit_message.empty() ? std::string() : ": " + outcome.fit_message) +
-                   " (see diagnostics in the card)");
-  }
-  if (plan.rest_shape) write_rest_mesh(rest_mesh, report);
-  std::string vtk_collection;
-  if (!vtk_dir_.empty()) vtk_collection = write_refine_vtk(vtk_dir_, report);
-  report.runtime_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const nlohmann::json card = material_card(report);
+  RefineJob job;
+  job.mesh = mesh_path_;
+  if (app_->count("--estimate") > 0) job.estimate = estimate_;
+  job.estimator = estimator_;
+  job.volumetric = volumetric_;
+  job.json = json_path_;
+  job.vtk = vtk_dir_;
+  if (app_->count("--max-strain") > 0) job.max_strain = max_strain_;
+  job.no_force_offset = no_force_offset_;
+  if (app_->count("--initial-modulus") > 0) job.initial_modulus = initial_modulus_pa_;
+  if (app_->count("--control-points") > 0) job.control_points = control_points_;
+  if (app_->count("--rest-frame") > 0) job.rest_frame = rest_frame_;
+  if (app_->count("--rest-mesh") > 0) job.rest_mesh = rest_mesh_path_;
+  if (app_->count("--until") > 0) job.until = until_s_;
+  if (app_->count("--substeps") > 0) job.substeps = substeps_;
+  job.threads = threads_;
+  job.progress = !quiet_;
+  const RefineDone done = run_refine_job(job, recording_from(recording_), report_warning);
   if (json_path_ == "-") {
-    std::cout << card.dump(2) << '\n';
+    std::cout << done.card.dump(2) << '\n';
   } else {
-    if (!json_path_.empty()) write_file_atomically(json_path_, card.dump(2) + "\n");
-    std::cout << refine_summary(report);
-    if (plan.rest_shape) std::cout << "wrote " << rest_mesh << '\n';
-    if (!vtk_collection.empty()) std::cout << "wrote " << vtk_collection << '\n';
+    std::cout << done.summary;
+    if (!done.rest_mesh.empty()) std::cout << "wrote " << done.rest_mesh << '\n';
+    if (!done.vtk_collection.empty()) std::cout << "wrote " << done.vtk_collection << '\n';
     if (!json_path_.empty()) std::cout << "wrote " << json_path_ << '\n';
   }
   std::cout.flush();

@@ -1,44 +1,19 @@
 #include "command_simulate.hpp"
 
-#include <cstdio>
-#include <filesystem>
 #include <iostream>
-#include <stdexcept>
 #include <string>
-#include <system_error>
 #include <vector>
 
 #include "exit_status.hpp"
+#include "job_simulate.hpp"
 
 namespace pliant::cli {
 namespace {
-
-namespace fs = std::filesystem;
-
-// Bounds the frame count (and memory) of a scenario a few seconds long.
-constexpr double max_rate_hz = 10000.0;
 
 std::string joined(const std::vector<std::string>& names) {
   std::string text;
   for (const std::string& name : names) text += (text.empty() ? "" : ", ") + name;
   return text;
-}
-
-void check_output_directory(const std::string& directory, bool force) {
-  std::error_code error;
-  const fs::file_status status = fs::status(directory, error);
-  if (!fs::exists(status)) return;
-  if (!fs::is_directory(status)) throw UsageError(directory + " exists and is not a directory");
-  if (force) return;
-  const bool empty = fs::is_empty(directory, error);
-  if (error) throw std::runtime_error("cannot read " + directory + ": " + error.message());
-  if (!empty) throw UsageError(directory + " is not empty; pass --force to replace the recording in it");
-}
-
-std::string number(double value) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%g", value);
-  return buffer;
 }
 
 }  // namespace
@@ -94,29 +69,16 @@ SimulateCommand::SimulateCommand(CLI::App& parent) {
 }
 
 int SimulateCommand::run() const {
-  // The library reads rate 0 as "the scenario's own rate"; on the command line that is leaving it out.
-  if (app_->count("--rate") > 0 && !(options_.rate_hz > 0.0)) throw UsageError("--rate must be > 0");
-  if (options_.rate_hz > max_rate_hz) throw UsageError("--rate must be at most " + number(max_rate_hz));
-  // Depth 0 likewise means the scenario's own depth.
-  if (app_->count("--depth") > 0 && !(options_.depth > 0.0)) throw UsageError("--depth must be in (0, 2]");
-  host::ScenarioOptions options = options_;
-  check_output_directory(output_, force_);
-  host::ScenarioResult scenario;
-  try {
-    if (app_->count("--effect") > 0) host::parse_effect_argument(options_.effect, options);
-    scenario = host::make_scenario(scenario_, options);
-  } catch (const std::invalid_argument& e) {
-    // make_scenario validates the scenario name, the option values and the effect.
-    throw UsageError(e.what());
-  }
-  host::write_scenario(scenario, output_);
-
-  const host::Recording& rec = scenario.recording;
-  // The summary names what is visible in the recording; the effect stays in truth.json.
-  std::cout << "wrote " << output_ << ": " << scenario_ << ", " << rec.particle_count << " particles x "
-            << rec.frame_count() << " frames (" << rec.dimension << "D, " << rec.length_unit << "), msm_beta "
-            << number(options_.msm_beta) << ", msm_alpha " << number(options_.msm_alpha) << ", noise "
-            << number(options_.noise) << ", seed " << options_.seed << "; truth in truth.json\n";
+  SimulateJob job;
+  job.scenario = scenario_;
+  job.output = output_;
+  job.options = options_;
+  if (app_->count("--rate") > 0) job.rate = options_.rate_hz;
+  if (app_->count("--depth") > 0) job.depth = options_.depth;
+  if (app_->count("--effect") > 0) job.effect = options_.effect;
+  job.force = force_;
+  const host::ScenarioResult scenario = run_simulate_job(job);
+  std::cout << simulate_summary(job, scenario);
   return exit_ok;
 }
 

@@ -1,11 +1,5 @@
 #include "model_form_options.hpp"
 
-#include <cmath>
-#include <stdexcept>
-
-#include "exit_status.hpp"
-#include "pliant/core/deformability.hpp"
-
 namespace pliant::cli {
 
 void ModelFormOptions::add_to(CLI::App& app) {
@@ -27,57 +21,13 @@ void ModelFormOptions::add_to(CLI::App& app) {
       ->capture_default_str();
 }
 
-bool ModelFormOptions::given(const CLI::App& app) {
-  return app.count("--alpha") + app.count("--msm-alpha") + app.count("--steps-per-frame") +
-             app.count("--cluster-radius") >
-         0;
-}
-
-namespace {
-
-// The whole of `text` as a number, or false.
-bool parse_number(const std::string& text, double& value) {
-  std::size_t used = 0;
-  try {
-    value = std::stod(text, &used);
-  } catch (const std::exception&) {
-    return false;
-  }
-  return used == text.size();
-}
-
-}  // namespace
-
-ModelFormChoice ModelFormOptions::apply(const CLI::App& app) const {
-  ModelFormChoice choice;
-  try {
-    host::parse_alpha_choice(alpha_, choice.alpha, choice.msm_alpha);
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(e.what());
-  }
-  if (app.count("--msm-alpha") > 0) {
-    if (!(msm_alpha_ > 0.0 && msm_alpha_ <= 1.0)) throw UsageError("--msm-alpha must be in (0, 1]");
-    choice.alpha = host::AlphaMode::fixed;
-    choice.msm_alpha = msm_alpha_;
-  }
-  if (steps_per_frame_ != "auto") {
-    double steps = 0;
-    if (!parse_number(steps_per_frame_, steps) || steps != std::floor(steps) || steps < 1 ||
-        steps > max_steps_per_frame) {
-      throw UsageError("--steps-per-frame must be 'auto' or a whole number in 1.." +
-                       std::to_string(max_steps_per_frame) + ", not '" + steps_per_frame_ + "'");
-    }
-    choice.steps_per_frame = static_cast<int>(steps);
-  }
-  if (cluster_radius_ != "auto") {
-    double radius = 0;
-    if (!parse_number(cluster_radius_, radius) || !(radius >= 1.0 && radius <= 4.0)) {
-      throw UsageError("--cluster-radius must be 'auto' or a number in [1, 4], not '" + cluster_radius_ + "'");
-    }
-    choice.cluster_radius_auto = false;
-    choice.cluster_radius_factor = radius;
-  }
-  return choice;
+ModelFormText ModelFormOptions::text(const CLI::App& app) const {
+  ModelFormText text;
+  if (app.count("--alpha") > 0) text.alpha = alpha_;
+  if (app.count("--msm-alpha") > 0) text.msm_alpha = msm_alpha_;
+  if (app.count("--steps-per-frame") > 0) text.steps_per_frame = steps_per_frame_;
+  if (app.count("--cluster-radius") > 0) text.cluster_radius = cluster_radius_;
+  return text;
 }
 
 }  // namespace pliant::cli

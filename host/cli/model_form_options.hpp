@@ -1,34 +1,23 @@
 // `--alpha`, `--msm-alpha`, `--steps-per-frame` and `--cluster-radius`: the MSM baseline's model
-// form, shared by `pliant estimate` and `pliant diagnose` (docs/estimation.md).
+// form, shared by `pliant estimate` and `pliant diagnose` (docs/estimation.md). This registers
+// the options; model_form.hpp validates what they say.
 #pragma once
 
 #include <string>
 
 #include <CLI/CLI.hpp>
 
-#include "pliant/host/estimate.hpp"
+#include "model_form.hpp"
 
 namespace pliant::cli {
-
-/// What the options chose; the defaults are every choice automatic.
-struct ModelFormChoice {
-  host::AlphaMode alpha = host::AlphaMode::automatic;
-  double msm_alpha = 1.0;   ///< held value
-  int steps_per_frame = 0;  ///< 0: automatic
-  bool cluster_radius_auto = true;
-  double cluster_radius_factor = 1.5;  ///< held value, and the first the automatic choice tries
-};
 
 class ModelFormOptions {
  public:
   /// Registers the four options on `app`.
   void add_to(CLI::App& app);
 
-  /// The parsed choice. Throws UsageError naming a bad value.
-  ModelFormChoice apply(const CLI::App& app) const;
-
-  /// True when any of the options was given.
-  static bool given(const CLI::App& app);
+  /// What was given on the command line of `app` (options not given stay empty).
+  ModelFormText text(const CLI::App& app) const;
 
  private:
   std::string alpha_ = "auto";

@@ -13,7 +13,7 @@
 #include "pliant/hal/clock.hpp"
 #include "pliant/hal/mock/fault_script.hpp"
 #include "pliant/hal/mock/replay_devices.hpp"
-#include "pliant/host/msm_setup.hpp"
+#include "pliant/host/replay/online_estimator.hpp"
 #include "pliant/host/replay/replay_channels.hpp"
 
 namespace pliant::host {
@@ -21,71 +21,6 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kFaultStep_s = 0.001;  // stepped clock advance while no device delivers
-
-// The online estimator over the particle observer's frames, for one dimension.
-class Estimator {
- public:
-  virtual ~Estimator() = default;
-  /// One delivered frame: recorded time (for driven windows) and dt since the previous one.
-  virtual Status update(const hal::ParticleFrame& frame, double recorded_t_s, double dt_s) = 0;
-  virtual OnlineDeformabilityEstimate estimate() const = 0;
-  virtual std::uint32_t rejected() const = 0;
-  virtual std::uint32_t empty() const = 0;
-};
-
-template <int Dim>
-class EstimatorOf final : public Estimator {
- public:
-  using Vec = Eigen::Matrix<double, Dim, 1>;
-  EstimatorOf(const Recording& recording, const ReplayOptions& options) : recording_(recording) {
-    model_ = build_msm_model<Dim>(recording, MsmSetupOptions{});
-    OnlineDeformabilityConfig config;
-    config.candidates = options.candidates;
-    config.alpha_candidates = options.alpha_candidates;
-    config.step_candidates = options.step_candidates;
-    config.equilibrium_iterations = options.equilibrium_iterations;
-    block_.resize(online_deformability_workspace_size(model_->model, config));
-    Arena arena(block_.data(), block_.size());
-    require_ok(online_deformability_init(arena, model_->model, base_params<Dim>(recording, options.msm_alpha), config,
-                                         online_),
-               "online estimator");
-    const auto n = static_cast<std::size_t>(recording.particle_count);
-    observed_.assign(n, Vec::Zero());
-    driven_ids_.reserve(n);
-    driven_targets_.reserve(n);
-  }
-
-  Status update(const hal::ParticleFrame& frame, double recorded_t_s, double dt_s) override {
-    const int n = recording_.particle_count;
-    for (int i = 0; i < n; ++i) {
-      for (int d = 0; d < Dim; ++d) observed_[static_cast<std::size_t>(i)](d) = frame.positions[i * Dim + d];
-    }
-    driven_ids_.clear();
-    driven_targets_.clear();
-    for (const DrivenWindow& w : recording_.driven) {
-      const Vec& p = observed_[static_cast<std::size_t>(w.id)];
-      if (!w.active_at(recorded_t_s) || !p.allFinite()) continue;
-      if (std::find(driven_ids_.begin(), driven_ids_.end(), w.id) != driven_ids_.end()) continue;
-      driven_ids_.push_back(w.id);
-      driven_targets_.push_back(p);
-    }
-    const MsmDrivenTargets<Dim, double> driven{driven_ids_.data(), driven_targets_.data(),
-                                               static_cast<int>(driven_ids_.size())};
-    return online_deformability_update(model_->model, online_, dt_s, driven, observed_.data());
-  }
-  OnlineDeformabilityEstimate estimate() const override { return online_deformability_estimate(online_); }
-  std::uint32_t rejected() const override { return online_.rejected_frames; }
-  std::uint32_t empty() const override { return online_.empty_frames; }
-
- private:
-  const Recording& recording_;
-  std::unique_ptr<HostMsmModel<Dim>> model_;
-  std::vector<unsigned char> block_;
-  OnlineDeformability<Dim, double> online_;
-  std::vector<Vec> observed_;
-  std::vector<int> driven_ids_;
-  std::vector<Vec> driven_targets_;
-};
 
 hal::FaultScript parse_script(const std::string& text) {
   hal::FaultScript script;
@@ -187,13 +122,14 @@ ReplaySummary replay_recording(const Recording& recording, const ReplayOptions& 
     throw std::invalid_argument("fault script: 'gripper' events but the recording has no gripper.csv");
   }
 
-  std::unique_ptr<Estimator> estimator;
+  std::unique_ptr<OnlineRecordingEstimator> estimator;
   if (options.estimate) {
-    if (recording.dimension == 2) {
-      estimator = std::make_unique<EstimatorOf<2>>(recording, options);
-    } else {
-      estimator = std::make_unique<EstimatorOf<3>>(recording, options);
-    }
+    OnlineDeformabilityConfig config;
+    config.candidates = options.candidates;
+    config.alpha_candidates = options.alpha_candidates;
+    config.step_candidates = options.step_candidates;
+    config.equilibrium_iterations = options.equilibrium_iterations;
+    estimator = std::make_unique<OnlineRecordingEstimator>(recording, config, options.msm_alpha);
   }
 
   configure_and_start(observer, "particle observer");
@@ -247,7 +183,7 @@ ReplaySummary replay_recording(const Recording& recording, const ReplayOptions& 
           const double recorded_t = recording.frame_times_s[static_cast<std::size_t>(observer.last_index())];
           // The first frame only anchors dt (the estimator starts at the rest shape).
           if (std::isfinite(previous_stamp)) {
-            event.estimator_status = estimator->update(frame, recorded_t, dt);
+            event.estimator_status = estimator->update(frame.positions, recorded_t, dt);
             estimate = estimator->estimate();
             event.estimate = &estimate;
           }
@@ -289,8 +225,8 @@ ReplaySummary replay_recording(const Recording& recording, const ReplayOptions& 
   if (estimator) {
     summary.estimated = true;
     summary.estimate = estimator->estimate();
-    summary.estimator_rejected_frames = estimator->rejected();
-    summary.estimator_empty_frames = estimator->empty();
+    summary.estimator_rejected_frames = estimator->rejected_frames();
+    summary.estimator_empty_frames = estimator->empty_frames();
   }
   return summary;
 }
