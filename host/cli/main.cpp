@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli_registry.hpp"
+#include "command_batch.hpp"
 #include "command_devices.hpp"
 #include "command_diagnose.hpp"
 #include "command_estimate.hpp"
@@ -78,6 +79,7 @@ int run(int argc, char** argv) {
   ReplayCommand replay(app);
   DevicesCommand devices(app);
   RecordCommand record(app);
+  BatchCommand batch(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& done) {  // --help, --version
@@ -98,6 +100,7 @@ int run(int argc, char** argv) {
   if (replay.selected()) return run_reporting_errors("pliant replay", [&] { return replay.run(); });
   if (devices.selected()) return run_reporting_errors("pliant devices", [&] { return devices.run(); });
   if (record.selected()) return run_reporting_errors("pliant record", [&] { return record.run(); });
+  if (batch.selected()) return run_reporting_errors("pliant batch", [&] { return batch.run(); });
   std::cerr << app.help();
   return exit_usage;
 }
