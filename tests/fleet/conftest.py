@@ -1,7 +1,8 @@
 """Shared helpers of the fleet tests: the pliant program, simulated recordings, running a batch.
 
-ctest sets PLIANT_CLI (the built pliant) and PYTHONPATH (the package directory); run by hand:
-PLIANT_CLI=build/bin/pliant PYTHONPATH=host/python /usr/bin/python3 -m pytest tests/fleet
+ctest sets PLIANT_CLI (the built pliant), PLIANT_EXAMPLES_DIR and PYTHONPATH (the package
+directory); by hand: PLIANT_CLI=build/bin/pliant PLIANT_EXAMPLES_DIR=examples PYTHONPATH=host/python
+/usr/bin/python3 -m pytest tests/fleet
 """
 
 import json
@@ -21,6 +22,14 @@ def cli():
     path = os.environ.get("PLIANT_CLI")
     if not path or not os.access(path, os.X_OK):
         pytest.fail("PLIANT_CLI must name the built pliant program (ctest sets it)")
+    return path
+
+
+@pytest.fixture(scope="session")
+def examples():
+    path = os.environ.get("PLIANT_EXAMPLES_DIR")
+    if not path or not os.path.isdir(path):
+        pytest.fail("PLIANT_EXAMPLES_DIR must name the repository's examples/ (ctest sets it)")
     return path
 
 

@@ -200,16 +200,6 @@ class Progress:
             sys.stderr.write("\n")
 
 
-def _suspicious_counts(keys, dask_scheduler=None):
-    """On the scheduler: how often each task's worker died while the task was assigned to it."""
-    counts = {}
-    for key in keys:
-        state = dask_scheduler.tasks.get(key)
-        if state is not None:
-            counts[key] = state.suspicious
-    return counts
-
-
 def open_client(config):
     """A Dask client: on the scheduler at config.scheduler, or on a new local cluster."""
     import dask
@@ -328,7 +318,8 @@ def _run_tasks(config, tasks, todo, store, stats):
         raise UsageError("Dask distributed is not installed: apt-get install python3-distributed") from None
     import cloudpickle
 
-    # The workers get the task code by value: they need Dask and pliant, not this package.
+    # The workers and the scheduler get fleet_task's code by value: they need Dask and the pliant
+    # program, not this package.
     cloudpickle.register_pickle_by_value(fleet_task)
     opened = time.monotonic()
     client, cluster = open_client(config)
@@ -368,7 +359,7 @@ def _run_tasks(config, tasks, todo, store, stats):
 
 def _ask_suspicious(client, keys):
     try:
-        return client.run_on_scheduler(_suspicious_counts, keys)
+        return client.run_on_scheduler(fleet_task.suspicious_counts, keys)
     except Exception:  # a scheduler that refuses to run code: attempts stay unknown
         return {}
 

@@ -5,8 +5,8 @@ costs one row: a crash is the child's exit status, a hang is killed at the task'
 the worker goes on with the next task. The child asks the kernel for SIGKILL when the worker
 that started it dies (setpriv --pdeathsig), so a worker killed mid-task leaves no orphan behind.
 
-Only the standard library: the batch sends this module to the workers by value, so a worker
-needs Dask and the `pliant` program, not this package.
+Only the standard library: the batch sends this module's code to the workers and the scheduler
+by value, so they need Dask and the `pliant` program, not this package.
 """
 
 from __future__ import annotations
@@ -73,6 +73,17 @@ def run_job(spec):
     fields.update(result_fields(spec["job"], document))
     fields["status"] = "ok"
     return fields
+
+
+def suspicious_counts(keys, dask_scheduler=None):
+    """Run on the scheduler (Client.run_on_scheduler): for each task key it still knows, how
+    many times a worker died while the task was assigned to it."""
+    counts = {}
+    for key in keys:
+        state = dask_scheduler.tasks.get(key)
+        if state is not None:
+            counts[key] = state.suspicious
+    return counts
 
 
 def _kill_group(child):
