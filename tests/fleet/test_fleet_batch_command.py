@@ -36,37 +36,43 @@ def test_help_is_the_fleets(cli):
 
 
 def test_small_batches_through_the_command_line(tmp_path, cli, examples):
-    """Two batches into one results directory: estimate on two presses, then refine on a list
-    of them and a real compression test. The table holds the rows of both."""
+    """Three batches into one results directory: estimate on two presses; refine on a list of
+    them and a real compression test; the first again, which finds everything done."""
     for index in range(2):
         simulate(cli, tmp_path / "presses" / f"p{index}", beta=0.2 + 0.3 * index, seed=index + 5)
     shutil.copytree(os.path.join(examples, "phantom_compression", "EF30_0T_A5"), tmp_path / "phantom")
     (tmp_path / "list.txt").write_text("presses/p0\npresses/p1\nphantom\n")
     out = tmp_path / "out"
-    first = pliant(cli, "batch", tmp_path / "presses", "-o", out, "--workers", 1, "--jobs", "estimate", "--quiet")
+    estimate = ["batch", tmp_path / "presses", "-o", out, "--workers", 1, "--jobs", "estimate", "--quiet"]
+    first = pliant(cli, *estimate)
     assert first.returncode == 0, first.stderr
     assert "2 recordings, 2 rows: estimate 2 (0 errors)" in first.stdout
+    assert "this batch: 2 jobs ran, 0 done before" in first.stdout
+    rows = {os.path.basename(row["recording"]): row for row in read_csv(out / "results.csv")}
+    for name in ("p0", "p1"):
+        assert rows[name]["status"] == "ok" and 0 <= rows[name]["msm_beta"] <= 1 and rows[name]["msm_beta_sd"] > 0
+        assert rows[name]["verdict"] is None and rows[name]["attempts"] == 1 and rows[name]["job"] == "estimate"
+
     second = pliant(cli, "batch", tmp_path / "list.txt", "-o", out, "--workers", 1, "--jobs", "refine",
                     "--refine-options=--max-strain 0.1", "--quiet")
     assert second.returncode == 0, second.stderr
-
-    rows = {(os.path.basename(row["recording"]), row["job"]): row for row in read_csv(out / "results.csv")}
-    assert sorted(rows) == [("p0", "estimate"), ("p0", "refine"), ("p1", "estimate"), ("p1", "refine"),
-                            ("phantom", "refine")]
-    for name in ("p0", "p1"):
-        estimate = rows[(name, "estimate")]
-        assert estimate["status"] == "ok" and 0 <= estimate["msm_beta"] <= 1 and estimate["msm_beta_sd"] > 0
-        assert estimate["verdict"] is None and estimate["attempts"] == 1
-        refine = rows[(name, "refine")]  # a 2D image-plane press: no material card
-        assert refine["status"] == "error" and refine["exit_status"] == 2
-        assert refine["error"].startswith("pliant refine: "), refine
-    card = rows[("phantom", "refine")]
-    assert card["status"] == "ok" and card["exit_status"] == 0, card
+    rows = {os.path.basename(row["recording"]): row for row in read_csv(out / "results.csv")}
+    assert sorted(rows) == ["p0", "p1", "phantom"]
+    for name in ("p0", "p1"):  # 2D image-plane presses: no material card
+        assert rows[name]["status"] == "error" and rows[name]["exit_status"] == 2
+        assert rows[name]["error"].startswith("pliant refine: "), rows[name]
+    card = rows["phantom"]
+    assert card["status"] == "ok" and card["exit_status"] == 0 and card["job"] == "refine", card
     assert 5e4 < card["youngs_modulus"] < 5e5 and card["youngs_modulus_sd"] > 0
     assert card["parameters"]["youngs_modulus"] == card["youngs_modulus"]
     summary = read_summary(out)
     assert summary["batch"] == dict(summary["batch"], workers=1, ran=3, skipped=0, recordings=3)
-    assert summary["jobs"] == {"estimate": {"rows": 2, "ok": 2, "errors": 0}, "refine": {"rows": 3, "ok": 1, "errors": 2}}
+    assert summary["jobs"] == {"refine": {"rows": 3, "ok": 1, "errors": 2, "pending": 0}}
+
+    third = pliant(cli, *estimate)
+    assert third.returncode == 0, third.stderr
+    assert "this batch: 0 jobs ran, 2 done before" in third.stdout
+    assert [row["job"] for row in read_csv(out / "results.csv")] == ["estimate", "estimate"]
 
 
 def test_missing_python_pieces_exit_2(tmp_path, cli):

@@ -8,6 +8,7 @@ A second run of the same batch must run nothing and leave the same table.
 """
 
 import csv
+import json
 import os
 import signal
 import subprocess
@@ -71,7 +72,7 @@ def running_jobs(batch_pid):
 
 def rows_written(out):
     try:
-        with open(os.path.join(out, "results.jsonl")) as stream:
+        with open(os.path.join(out, "journal.jsonl")) as stream:
             return sum(1 for line in stream if line.endswith("\n"))
     except FileNotFoundError:
         return 0
@@ -119,7 +120,9 @@ def test_a_worker_killed_mid_batch_loses_and_doubles_nothing(tmp_path, cli):
     assert all(len(found) == 1 for found in by_recording.values()), "a recording with more than one row"
     assert len({row["key"] for row in rows}) == len(rows)
     with open(os.path.join(out, "results.jsonl")) as stream:
-        assert len(stream.readlines()) == len(rows)
+        assert [json.loads(line) for line in stream] == rows  # the same table in JSON lines
+    with open(os.path.join(out, "journal.jsonl")) as stream:
+        assert sorted(json.loads(line)["key"] for line in stream) == sorted(row["key"] for row in rows)
 
     for path, outcome in expected.items():
         row = by_recording[path][0]

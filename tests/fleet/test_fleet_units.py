@@ -1,4 +1,4 @@
-"""The fleet's parts without a cluster: keys, discovery, the row store, the table, the summary,
+"""The fleet's parts without a cluster: keys, discovery, the journal, the table, the summary,
 one task against stand-in programs, and the batch's argument errors."""
 
 import json
@@ -12,8 +12,9 @@ import pytest
 
 from conftest import run_fleet
 from pliant import fleet_task
+from pliant.fleet import table_rows
 from pliant.fleet_inputs import UsageError, describe_recording, find_recordings, task_key
-from pliant.fleet_table import (COLUMNS, NO_CLASS, ResultStore, StoreBusy, csv_text, json_line, normalized_row,
+from pliant.fleet_table import (COLUMNS, NO_CLASS, Journal, JournalBusy, csv_text, json_line, normalized_row,
                                 read_csv, summarize, summary_text)
 
 
@@ -141,52 +142,66 @@ def test_nothing_to_batch(tmp_path):
         find_recordings([str(tmp_path / "empty")])
 
 
-# ------------------------------------------------------------------------------------ row store
+# -------------------------------------------------------------------------------------- journal
 
 def row(key, recording="r", job="diagnose", **fields):
     return normalized_row({"key": key, "recording": recording, "job": job, "status": "ok", **fields})
 
 
-def test_store_keeps_one_row_per_key(tmp_path):
+def test_journal_keeps_one_row_per_key(tmp_path):
     out = str(tmp_path / "out")
-    store = ResultStore(out)
-    store.append(row("k1", error="first", status="error"))
-    store.append(row("k2", recording="q"))
-    store.append(row("k1", msm_beta=0.25))
-    assert len(store.rows) == 2 and store.rows["k1"]["msm_beta"] == 0.25
-    with pytest.raises(StoreBusy):
-        ResultStore(out)  # the lock: one batch per output directory
-    store.close()
+    journal = Journal(out)
+    journal.append(row("k1", error="first", status="error"))
+    journal.append(row("k2", recording="q"))
+    journal.append(row("k1", msm_beta=0.25))
+    assert len(journal.rows) == 2 and journal.rows["k1"]["msm_beta"] == 0.25
+    with pytest.raises(JournalBusy):
+        Journal(out)  # the lock: one batch per output directory
+    journal.close()
 
-    with open(os.path.join(out, "results.jsonl")) as stream:
+    with open(os.path.join(out, "journal.jsonl")) as stream:
         assert len(stream.readlines()) == 3  # appended as they came
-    reopened = ResultStore(out)
+    reopened = Journal(out)
     assert reopened.superseded_lines == 1
     assert reopened.rows["k1"]["msm_beta"] == 0.25 and reopened.rows["k1"]["error"] is None
     reopened.compact()
     reopened.close()
-    with open(os.path.join(out, "results.jsonl")) as stream:
+    with open(os.path.join(out, "journal.jsonl")) as stream:
         lines = [json.loads(line) for line in stream]
     assert [line["key"] for line in lines] == ["k2", "k1"]  # in table order: recording "q" before "r"
 
 
-def test_store_survives_a_torn_last_line(tmp_path):
+def test_journal_survives_a_torn_last_line(tmp_path):
     out = str(tmp_path / "out")
-    store = ResultStore(out)
-    store.append(row("k1"))
-    store.close()
-    with open(os.path.join(out, "results.jsonl"), "a") as stream:
+    journal = Journal(out)
+    journal.append(row("k1"))
+    journal.close()
+    with open(os.path.join(out, "journal.jsonl"), "a") as stream:
         stream.write(json_line(row("k2"))[:25])  # a batch killed while writing
-    store = ResultStore(out)
-    assert store.dropped_lines == 1 and list(store.rows) == ["k1"]
-    store.append(row("k3"))
-    store.close()
-    store = ResultStore(out)
-    assert sorted(store.rows) == ["k1", "k3"]
-    store.close()
+    journal = Journal(out)
+    assert journal.dropped_lines == 1 and list(journal.rows) == ["k1"]
+    journal.append(row("k3"))
+    journal.close()
+    journal = Journal(out)
+    assert sorted(journal.rows) == ["k1", "k3"]
+    journal.close()
 
 
 # ------------------------------------------------------------------------------- table, summary
+
+def test_table_rows_follow_the_batch():
+    entries = [{"recording": "a", "key": "k1", "job": "diagnose", "object": "foam"},
+               {"recording": "copy of a", "key": "k1", "job": "diagnose", "object": "foam"},
+               {"recording": "b", "key": "k2", "job": "diagnose", "object": ""}]
+    stored = {"k1": row("k1", recording="where a was", object="old class", msm_beta=0.3), "k9": row("k9")}
+    rows = table_rows(entries, stored)
+    assert [(r["recording"], r["object"], r["msm_beta"], r["status"]) for r in rows] == \
+        [("a", "foam", 0.3, "ok"), ("copy of a", "foam", 0.3, "ok"), ("b", "", None, "pending")]
+    assert rows[2]["error"].startswith("not run")
+    summary = summarize(rows)
+    assert summary["jobs"]["diagnose"] == {"rows": 3, "ok": 2, "errors": 0, "pending": 1}
+    assert "diagnose 3 (0 errors, 1 not run)" in summary_text(summary)
+
 
 def test_csv_and_json_lines_round_trip(tmp_path):
     rows = [
@@ -216,7 +231,8 @@ def test_summary_statistics_on_a_known_table():
     summary = summarize(rows)
 
     assert summary["recordings"] == 9 and summary["rows"] == 9 and summary["errors"] == 1
-    assert summary["jobs"] == {"diagnose": {"rows": 6, "ok": 5, "errors": 1}, "refine": {"rows": 3, "ok": 3, "errors": 0}}
+    assert summary["jobs"] == {"diagnose": {"rows": 6, "ok": 5, "errors": 1, "pending": 0},
+                               "refine": {"rows": 3, "ok": 3, "errors": 0, "pending": 0}}
     assert summary["verdicts"] == {"consistent": 4, "missing_physics": 1}
     assert summary["effects"] == {"none": 4, "plasticity": 1}
     assert summary["objects_per_class"] == {NO_CLASS: 1, "foam A": 5, "silicone": 3}

@@ -27,7 +27,8 @@ import time
 
 from . import fleet_task
 from .fleet_inputs import UsageError, absolute_option_files, describe_recording, find_recordings, task_key
-from .fleet_table import ResultStore, StoreBusy, csv_text, is_final, summarize, summary_text, write_atomically
+from .fleet_table import (Journal, JournalBusy, csv_text, is_final, json_line, normalized_row, summarize,
+                          summary_text, write_atomically)
 
 EXIT_OK, EXIT_FAILURE, EXIT_USAGE = 0, 1, 2
 # Times the scheduler may lose a task's worker before the row gets an error instead: a worker
@@ -222,66 +223,85 @@ def open_client(config):
     return Client(cluster), cluster
 
 
-def plan_tasks(config, recordings):
-    """{key: spec} for every (recording, job), in batch order; copies of one recording share a key."""
+def plan_batch(config, recordings):
+    """The batch's entries, one per (recording, job) in table order, each {"recording", "key",
+    "job", "object"}; and {key: task spec} (copies of one recording share a key: one task)."""
+    entries = []
     tasks = {}
     for recording in recordings:
         for job in config.jobs:
             key = task_key(recording, job, config.options[job])
+            entries.append({"recording": recording.path, "key": key, "job": job, "object": recording.object})
             if key not in tasks:
                 tasks[key] = {"recording": recording.abspath, "job": job, "options": config.options[job],
-                              "cli": config.cli, "timeout_s": config.timeout_s,
-                              "row": {"recording": recording.path, "key": key, "job": job,
-                                      "object": recording.object}}
-    return tasks
+                              "cli": config.cli, "timeout_s": config.timeout_s}
+    return entries, tasks
 
 
 def run_batch(config, out=sys.stdout):
     """Runs the batch `config` describes; returns the summary (also written to OUT/summary.json).
 
-    The table and the summary are written from the stored rows even when the batch is
-    interrupted (KeyboardInterrupt is raised again after that).
+    The table and the summary are written from the journal even when the batch is interrupted
+    (KeyboardInterrupt is raised again after that).
     """
     recordings = [describe_recording(path, config.class_key) for path in find_recordings(config.sources)]
-    tasks = plan_tasks(config, recordings)
+    entries, tasks = plan_batch(config, recordings)
     try:
-        store = ResultStore(config.output)
-    except StoreBusy as error:
+        journal = Journal(config.output)
+    except JournalBusy as error:
         raise UsageError(str(error)) from None
     except OSError as error:
         raise UsageError(f"cannot write into {config.output}: {error.strerror or error}") from None
-    todo = [key for key in tasks if not _done(store.rows.get(key), config.retry_errors)]
+    todo = [key for key in tasks if not _done(journal.rows.get(key), config.retry_errors)]
     stats = {"ran": 0, "lost": 0, "startup_s": 0.0, "run_s": 0.0}
     started = time.monotonic()
     try:
         if todo:
-            _run_tasks(config, tasks, todo, store, stats)
+            first_entry = {}
+            for entry in entries:
+                first_entry.setdefault(entry["key"], entry)
+            _run_tasks(config, tasks, todo, first_entry, journal, stats)
     finally:
-        summary = _finish(config, store, recordings, tasks, todo, stats, time.monotonic() - started)
+        summary = _finish(config, journal, entries, tasks, todo, stats, time.monotonic() - started)
     _report(summary, config.output, out)
     if stats["lost"]:
         raise FleetFailure(f"{stats['lost']} jobs were lost with the scheduler; run the batch again to finish them")
     return summary
 
 
-def _finish(config, store, recordings, tasks, todo, stats, wall_s):
-    """Writes results.csv and summary.json from the stored rows and compacts results.jsonl."""
+def table_rows(entries, journal_rows):
+    """The table: for each entry its journal row, under the entry's own path and class (a copy
+    or a moved recording shows where it is now); an entry without one is "pending"."""
+    rows = []
+    for entry in entries:
+        stored = journal_rows.get(entry["key"])
+        if stored is None:
+            rows.append(normalized_row(dict(entry, status="pending",
+                                            error="not run: the batch stopped first; the next batch runs it")))
+        else:
+            rows.append(normalized_row(dict(stored, **entry)))
+    return rows
+
+
+def _finish(config, journal, entries, tasks, todo, stats, wall_s):
+    """Writes results.csv, results.jsonl and summary.json from the journal, then compacts it."""
     try:
-        rows = store.sorted_rows()
+        rows = table_rows(entries, journal.rows)
         summary = summarize(rows, config.class_key)
         summary["batch"] = {
-            "recordings": len(recordings), "jobs": len(tasks), "ran": stats["ran"],
-            "skipped": len(tasks) - len(todo), "lost": stats["lost"],
-            "not_run": len(todo) - stats["ran"] - stats["lost"],
+            "recordings": len({entry["recording"] for entry in entries}), "jobs": len(tasks),
+            "ran": stats["ran"], "skipped": len(tasks) - len(todo), "lost": stats["lost"],
+            "not_run": len(todo) - stats["ran"],
             "wall_s": round(wall_s, 3), "startup_s": round(stats["startup_s"], 3), "run_s": round(stats["run_s"], 3),
             "jobs_per_s": round(stats["ran"] / stats["run_s"], 4) if stats["ran"] and stats["run_s"] > 0 else None,
             "workers": None if config.scheduler else config.workers, "scheduler": config.scheduler,
         }
         write_atomically(os.path.join(config.output, "results.csv"), csv_text(rows))
+        write_atomically(os.path.join(config.output, "results.jsonl"), "".join(json_line(row) for row in rows))
         write_atomically(os.path.join(config.output, "summary.json"), _json_text(summary))
-        store.compact()
+        journal.compact()
     finally:
-        store.close()
+        journal.close()
     return summary
 
 
@@ -291,6 +311,8 @@ def _report(summary, output, out):
     line = f"this batch: {batch['ran']} jobs ran, {batch['skipped']} done before"
     if batch["ran"]:
         line += f", {batch['run_s']:.1f} s ({batch['jobs_per_s']:.3g} jobs/s) after {batch['startup_s']:.1f} s start-up"
+    if batch["not_run"]:
+        line += f"; {batch['not_run']} not run"
     out.write(line + "\n")
     out.write("wrote " + ", ".join(os.path.join(output, name)
                                    for name in ("results.csv", "results.jsonl", "summary.json")) + "\n")
@@ -308,8 +330,8 @@ def _done(row, retry_errors):
     return is_final(row) and not retry_errors
 
 
-def _run_tasks(config, tasks, todo, store, stats):
-    """Runs the keys `todo` on the cluster, appending each row to `store` as it arrives. Counts
+def _run_tasks(config, tasks, todo, first_entry, journal, stats):
+    """Runs the keys `todo` on the cluster, appending each row to `journal` as it arrives. Counts
     in `stats` the rows written ("ran"), the tasks lost with the scheduler ("lost": no row, the
     next batch runs them), the cluster's start-up and the time from submission to the last row."""
     try:
@@ -330,8 +352,7 @@ def _run_tasks(config, tasks, todo, store, stats):
     try:
         futures = {}
         for key in todo:
-            spec = {name: value for name, value in tasks[key].items() if name != "row"}
-            futures[client.submit(fleet_task.run_job, spec, key=f"pliant-{key}", pure=False)] = key
+            futures[client.submit(fleet_task.run_job, tasks[key], key=f"pliant-{key}", pure=False)] = key
         for batch in as_completed(list(futures), with_results=False).batches():
             suspicious = _ask_suspicious(client, [future.key for future in batch])
             for future in batch:
@@ -342,9 +363,9 @@ def _run_tasks(config, tasks, todo, store, stats):
                 if fields is None:
                     stats["lost"] += 1
                     continue
-                row = dict(tasks[key]["row"], **fields)
+                row = dict(first_entry[key], **fields)
                 row["finished_utc"] = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
-                store.append(row)
+                journal.append(row)
                 written.add(key)
                 stats["ran"] += 1
                 stats["run_s"] = time.monotonic() - submitted

@@ -1,5 +1,5 @@
-"""The fleet's results: the row store (JSON lines, appended as tasks finish), the CSV table and
-the summary. Columns and files: docs/fleet.md. Pure Python.
+"""The fleet's results: the journal (JSON lines, appended as tasks finish), the table (CSV and
+JSON lines) and the summary. Columns and files: docs/fleet.md. Pure Python.
 """
 
 from __future__ import annotations
@@ -48,7 +48,7 @@ FINAL_EXIT_STATUSES = (0, 1, 2)
 SUMMARY_PARAMETERS = ("msm_beta", "youngs_modulus")
 
 
-class StoreBusy(Exception):
+class JournalBusy(Exception):
     """Another batch holds the output directory."""
 
 
@@ -66,18 +66,19 @@ def row_order(row):
     return (row.get("recording") or "", row.get("job") or "", row.get("key") or "")
 
 
-class ResultStore:
-    """results.jsonl in an output directory: one JSON object per line, keyed by "key".
+class Journal:
+    """journal.jsonl in an output directory: every row any batch into it produced, one JSON
+    object per line, keyed by "key" (the cache that lets a batch skip what is done).
 
     Opening takes an exclusive lock on DIR/.lock (a second batch on the same directory gets
-    StoreBusy). load() reads every row, the last line of a key winning (a retry supersedes an
+    JournalBusy). Loading reads every row, the last line of a key winning (a retry supersedes an
     earlier failure); a torn last line (a batch killed mid-write) is counted and dropped.
     append() writes one row and fsyncs before returning, so a row acknowledged is on disk.
     """
 
     def __init__(self, directory):
         self.directory = directory
-        self.path = os.path.join(directory, "results.jsonl")
+        self.path = os.path.join(directory, "journal.jsonl")
         self.rows = {}
         self.dropped_lines = 0
         self.superseded_lines = 0
@@ -87,7 +88,7 @@ class ResultStore:
             fcntl.flock(self._lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
             self._lock.close()
-            raise StoreBusy(f"another batch is writing into {directory}") from None
+            raise JournalBusy(f"another batch is writing into {directory}") from None
         self._load()
         self._stream = open(self.path, "a", encoding="utf-8")
         if self._needs_newline:
@@ -129,7 +130,7 @@ class ResultStore:
         return sorted(self.rows.values(), key=row_order)
 
     def compact(self):
-        """Rewrites results.jsonl atomically with one line per key, in table order."""
+        """Rewrites the journal atomically with one line per key (the last), ordered by recording."""
         self._stream.close()
         write_atomically(self.path, "".join(json_line(row) for row in self.sorted_rows()))
         self._stream = open(self.path, "a", encoding="utf-8")
@@ -230,12 +231,15 @@ def summarize(rows, class_key="meta.object"):
     classes = {}
     for row in rows:
         job = row.get("job") or ""
-        counts = jobs.setdefault(job, {"rows": 0, "ok": 0, "errors": 0})
+        counts = jobs.setdefault(job, {"rows": 0, "ok": 0, "errors": 0, "pending": 0})
         counts["rows"] += 1
         recordings.add(row.get("recording"))
         label = row.get("object") or NO_CLASS
         entry = classes.setdefault(label, {"recordings": set(), "values": {}})
         entry["recordings"].add(row.get("recording"))
+        if row.get("status") == "pending":
+            counts["pending"] += 1
+            continue
         if row.get("status") != "ok":
             counts["errors"] += 1
             errors += 1
@@ -275,7 +279,9 @@ def _g(value):
 
 def summary_text(summary):
     """The summary as the few lines the batch prints."""
-    jobs = ", ".join(f"{job} {counts['rows']} ({counts['errors']} errors)" for job, counts in summary["jobs"].items())
+    jobs = ", ".join(f"{job} {counts['rows']} ({counts['errors']} errors"
+                     + (f", {counts['pending']} not run)" if counts["pending"] else ")")
+                     for job, counts in summary["jobs"].items())
     lines = [f"{summary['recordings']} recordings, {summary['rows']} rows: {jobs or 'none'}"]
     if summary["verdicts"]:
         lines.append("verdicts: " + ", ".join(f"{name} {count}" for name, count in summary["verdicts"].items()))
