@@ -9,6 +9,9 @@ packages=(
   dpkg-dev                       # tools/packages.sh: dpkg-shlibdeps reads the program's run-time Depends
   clang-format clang-tidy        # tools/lint.sh
   python3                        # tools/lint_tidy.py
+  python3-distributed            # pliant batch: the fleet on Dask distributed (host/python/pliant/fleet.py)
+  python3-tqdm                   # the fleet's progress bar
+  python3-pytest                 # the fleet's tests (tests/fleet)
   libeigen3-dev                  # core linear algebra (the only core dependency)
   nlohmann-json3-dev             # recording and result JSON (host)
   libcli11-dev                   # the pliant command line

@@ -4,9 +4,10 @@
 
 (`pliant batch` runs this module.) Each (recording, job) is one Dask task; the task runs the
 `pliant` command line in a child process (fleet_task.py) and returns one row. Rows are appended
-to OUT/results.jsonl as they arrive, keyed by the recording's content (fleet_inputs.py), so a
-batch that is stopped, killed or run again goes on where it was; OUT/results.csv and
-OUT/summary.json are written from those rows at the end (fleet_table.py). docs/fleet.md.
+to OUT/journal.jsonl as they arrive, keyed by the recording's content and the job
+(fleet_inputs.py), so a batch that is stopped, killed or run again goes on where it was. At the
+end the table of the batch (OUT/results.csv and OUT/results.jsonl, one row per recording and
+job) and OUT/summary.json are written from the journal (fleet_table.py). docs/fleet.md.
 
 Exit status: 0 the batch ran (rows may carry errors: see the summary), 1 the batch could not
 finish (the scheduler was lost; what was done is kept), 2 bad arguments, Dask missing, or a
@@ -52,8 +53,8 @@ def build_parser():
         prog=program_name(),
         description="Run pliant diagnose, refine or estimate over many recordings on Dask distributed: an "
         "embedded local cluster, or a running scheduler. One row per recording and job in OUT/results.csv and "
-        "OUT/results.jsonl, a fleet summary in OUT/summary.json. Rows are keyed by the recordings' content: run "
-        "the same batch again and only what is not done runs.",
+        "OUT/results.jsonl, a fleet summary in OUT/summary.json. Results are kept by the recordings' content in "
+        "OUT/journal.jsonl: run the same batch again and only what is not done runs.",
         epilog="Job options are the command line's own (pliant diagnose --help ...), given as one string, e.g. "
         "--diagnose-options='--model fem'. Exit status: 0 the batch ran (rows may hold errors), 1 it could not "
         "finish (rerun to go on), 2 bad arguments, Dask missing or no scheduler. docs/fleet.md",
