@@ -133,11 +133,11 @@ def job_options(job, text):
         options = shlex.split(text)
     except ValueError as error:
         raise UsageError(f"--{job}-options: {error}") from None
+    if options and not options[0].startswith("-"):
+        raise UsageError(f"--{job}-options: '{options[0]}' is not an option (the batch gives the recording)")
     for option in options:
         if option.split("=", 1)[0] in RESERVED_OPTIONS:
             raise UsageError(f"--{job}-options: {option.split('=', 1)[0]} is set by the batch")
-        if not option.startswith("-") and option is options[0]:
-            raise UsageError(f"--{job}-options: the recording is given by the batch; '{option}' is not an option")
     return absolute_option_files(options)
 
 
