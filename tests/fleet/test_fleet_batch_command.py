@@ -110,8 +110,9 @@ def test_a_batch_on_a_running_scheduler(tmp_path, cli):
             assert scheduler.poll() is None, scheduler.stderr.read().decode()
             time.sleep(0.1)
         address = json.loads(scheduler_file.read_text())["address"]
-        worker = start([sys.executable, "-m", "distributed.cli.dask_worker", address, "--host", "127.0.0.1", "--nthreads", "1",
-                        "--no-dashboard", "--local-directory", str(tmp_path / "worker")], dict(env, PATH="/usr/bin:/bin"))
+        worker = start([sys.executable, "-m", "distributed.cli.dask_worker", address, "--host", "127.0.0.1",
+                        "--nthreads", "1", "--no-dashboard", "--local-directory", str(tmp_path / "worker")],
+                       dict(env, PATH="/usr/bin:/bin"))
         for index in range(2):
             simulate(cli, tmp_path / "presses" / f"p{index}", seed=index + 20)
         out = tmp_path / "out"
