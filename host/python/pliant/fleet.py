@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import datetime
+import importlib
 import json
 import logging
 import os
@@ -416,7 +417,7 @@ def main(argv=None):
     args = parser.parse_args(argv)
     prog = program_name()
     try:
-        import distributed  # noqa: F401
+        importlib.import_module("distributed")
     except ImportError:
         print(f"{prog}: Dask distributed is not installed: apt-get install python3-distributed", file=sys.stderr)
         return EXIT_USAGE
