@@ -12,18 +12,18 @@ namespace {
 
 using Paths = std::vector<std::string>;
 
-TEST(CliBatch, PythonPathBuiltInListWithoutOverride) {
+TEST(cli, BatchPythonPathBuiltInListWithoutOverride) {
   EXPECT_EQ(fleet_python_path(nullptr, "/src/host/python:/usr/lib/python3/dist-packages"),
             (Paths{"/src/host/python", "/usr/lib/python3/dist-packages"}));
 }
 
-TEST(CliBatch, PythonPathOverrideReplacesTheBuiltInList) {
+TEST(cli, BatchPythonPathOverrideReplacesTheBuiltInList) {
   EXPECT_EQ(fleet_python_path("/opt/fleet", "/src/host/python"), (Paths{"/opt/fleet"}));
   EXPECT_EQ(fleet_python_path("/a:/b", "/src/host/python"), (Paths{"/a", "/b"}));
   EXPECT_EQ(fleet_python_path("", "/src/host/python"), Paths{});  // set but empty: nothing of ours
 }
 
-TEST(CliBatch, PythonPathEmptyEntriesAreDropped) {
+TEST(cli, BatchPythonPathEmptyEntriesAreDropped) {
   EXPECT_EQ(fleet_python_path("::/a::/b:", "unused"), (Paths{"/a", "/b"}));
   EXPECT_EQ(fleet_python_path(nullptr, ""), Paths{});
 }
