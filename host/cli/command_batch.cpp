@@ -53,7 +53,9 @@ BatchCommand::BatchCommand(CLI::App& parent) {
   app_->prefix_command();   // every argument after `batch` is the fleet's, unparsed
 }
 
-int BatchCommand::run() const {
+int BatchCommand::run() const { return run_fleet(app_->remaining()); }
+
+int run_fleet(const std::vector<std::string>& fleet_arguments) {
   const std::string python = PLIANT_BATCH_PYTHON;
   if (access(python.c_str(), X_OK) != 0) {
     throw UsageError(python + " is missing: the fleet needs Debian's python3 and Dask (apt-get install python3 " +
@@ -80,7 +82,7 @@ int BatchCommand::run() const {
   set_environment("PLIANT_FLEET_PROG", "pliant batch");
 
   std::vector<std::string> arguments{python, "-m", "pliant.fleet"};
-  for (const std::string& argument : app_->remaining()) arguments.push_back(argument);
+  for (const std::string& argument : fleet_arguments) arguments.push_back(argument);
   std::vector<char*> argv;
   for (std::string& argument : arguments) argv.push_back(argument.data());
   argv.push_back(nullptr);

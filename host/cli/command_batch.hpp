@@ -6,8 +6,10 @@
 //                     (CMake: the package directory of the build, then the install prefix's
 //                     lib/python3/dist-packages), before any PYTHONPATH already set;
 //   PLIANT_FLEET_PROG "pliant batch", the name the fleet's messages and --help use.
-// Every argument, --help included, goes to the fleet unparsed. Without python3, or without the
-// fleet's package, it exits 2 naming what to install; the fleet itself does the same for Dask.
+// Every argument, --help included, goes to the fleet unparsed: main.cpp hands `pliant batch ...`
+// to run_fleet() before CLI11 parses anything, so no argument (a directory named like another
+// command, a `--`) is read as pliant's own. Without python3, or without the fleet's package, it
+// exits 2 naming what to install; the fleet itself does the same for Dask.
 #pragma once
 
 #include <string>
@@ -17,13 +19,18 @@
 
 namespace pliant::cli {
 
+/// Replaces the process with the fleet on `arguments` (those after `batch`); returns only by
+/// throwing (exit_status.hpp: UsageError when python3 or the package is missing).
+int run_fleet(const std::vector<std::string>& arguments);
+
 class BatchCommand {
  public:
-  /// Registers `batch` on `parent`, taking every argument after it as the fleet's.
+  /// Registers `batch` on `parent` (for `pliant --help`), taking every argument after it as the
+  /// fleet's should CLI11 parse it after all.
   explicit BatchCommand(CLI::App& parent);
 
   bool selected() const { return app_->parsed(); }
-  /// Replaces the process with the fleet; returns only by throwing (exit_status.hpp).
+  /// run_fleet() on the arguments after `batch`.
   int run() const;
 
  private:

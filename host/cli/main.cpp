@@ -56,6 +56,11 @@ std::vector<AddedCommand> add_optional_commands(CLI::App& app) {
 }
 
 int run(int argc, char** argv) {
+  // `pliant batch ...`: every argument is the fleet's, before CLI11 could read one as ours.
+  if (argc > 1 && std::string(argv[1]) == "batch") {
+    const std::vector<std::string> arguments(argv + 2, argv + argc);
+    return run_reporting_errors("pliant batch", [&] { return run_fleet(arguments); });
+  }
   // A command this build was made without: say so rather than "unknown command".
   if (argc > 1) {
     const std::string missing = missing_command_message(cli_registry(), argv[1]);
