@@ -20,9 +20,9 @@ def clean_environment():
             if name not in ("PYTHONPATH", "PLIANT_CLI", "PLIANT_PYTHONPATH")}
 
 
-def pliant(cli, *arguments, env=None, timeout=180):
+def pliant(cli, *arguments, env=None, timeout=180, cwd=None):
     return subprocess.run([cli, *map(str, arguments)], capture_output=True, text=True, timeout=timeout,
-                          env=env if env is not None else clean_environment())
+                          env=env if env is not None else clean_environment(), cwd=cwd)
 
 
 def test_help_is_the_fleets(cli):
@@ -37,14 +37,15 @@ def test_help_is_the_fleets(cli):
 
 def test_small_batches_through_the_command_line(tmp_path, cli, examples):
     """Three batches into one results directory: estimate on two presses; refine on a list of
-    them and a real compression test; the first again, which finds everything done."""
+    them and a real compression test; the first again, which finds everything done. The presses
+    are in a directory named like a pliant command: it must reach the fleet as a directory."""
     for index in range(2):
-        simulate(cli, tmp_path / "presses" / f"p{index}", beta=0.2 + 0.3 * index, seed=index + 5)
+        simulate(cli, tmp_path / "estimate" / f"p{index}", beta=0.2 + 0.3 * index, seed=index + 5)
     shutil.copytree(os.path.join(examples, "phantom_compression", "EF30_0T_A5"), tmp_path / "phantom")
-    (tmp_path / "list.txt").write_text("presses/p0\npresses/p1\nphantom\n")
+    (tmp_path / "list.txt").write_text("estimate/p0\nestimate/p1\nphantom\n")
     out = tmp_path / "out"
-    estimate = ["batch", tmp_path / "presses", "-o", out, "--workers", 1, "--jobs", "estimate", "--quiet"]
-    first = pliant(cli, *estimate)
+    estimate = ["batch", "estimate", "-o", out, "--workers", 1, "--jobs", "estimate", "--quiet"]
+    first = pliant(cli, *estimate, cwd=tmp_path)
     assert first.returncode == 0, first.stderr
     assert "2 recordings, 2 rows: estimate 2 (0 errors)" in first.stdout
     assert "this batch: 2 jobs ran, 0 done before" in first.stdout
@@ -69,7 +70,7 @@ def test_small_batches_through_the_command_line(tmp_path, cli, examples):
     assert summary["batch"] == dict(summary["batch"], workers=1, ran=3, skipped=0, recordings=3)
     assert summary["jobs"] == {"refine": {"rows": 3, "ok": 1, "errors": 2, "pending": 0}}
 
-    third = pliant(cli, *estimate)
+    third = pliant(cli, *estimate, cwd=tmp_path)
     assert third.returncode == 0, third.stderr
     assert "this batch: 0 jobs ran, 2 done before" in third.stdout
     assert [row["job"] for row in read_csv(out / "results.csv")] == ["estimate", "estimate"]
