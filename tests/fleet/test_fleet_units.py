@@ -312,7 +312,7 @@ def test_task_reads_the_json_the_program_wrote(tmp_path):
     cli = stand_in(tmp_path, f"[ \"$1 $3 $5 $6\" = 'diagnose --json --quiet --model' ] || exit 7\n"
                    f"cat > \"$4\" <<'END'\n{json.dumps(DIAGNOSIS)}\nEND\n")
     fields = run_with(cli, options=["--model", "msm"])
-    assert fields["status"] == "ok" and fields["exit_status"] == 0 and fields["error"] == ""
+    assert fields["status"] == "ok" and fields["exit_status"] == 0 and fields["error"] is None
     assert fields["effect"] == "plasticity" and fields["runtime_s"] >= 0 and fields["worker"]
 
 

@@ -33,7 +33,7 @@ def run_job(spec):
     "cli": path of pliant, "timeout_s": float}. Never raises for a failure of the job: the
     returned fields say it in "status", "exit_status" and "error".
     """
-    fields = {"status": "error", "exit_status": None, "error": "", "worker": _worker_name(), "runtime_s": None}
+    fields = {"status": "error", "exit_status": None, "error": None, "worker": _worker_name(), "runtime_s": None}
     cli = spec["cli"]
     if not (os.path.isfile(cli) and os.access(cli, os.X_OK)):
         fields["error"] = f"the pliant command line {cli} is missing or not executable on this worker"
