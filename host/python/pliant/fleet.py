@@ -263,8 +263,13 @@ def run_batch(config, out=sys.stdout):
             for entry in entries:
                 first_entry.setdefault(entry["key"], entry)
             _run_tasks(config, tasks, todo, first_entry, journal, stats)
-    finally:
-        summary = _finish(config, journal, entries, tasks, todo, stats, time.monotonic() - started)
+    except UsageError:  # no cluster to run on: nothing ran, nothing to write
+        journal.close()
+        raise
+    except BaseException:
+        _finish(config, journal, entries, tasks, todo, stats, time.monotonic() - started)
+        raise
+    summary = _finish(config, journal, entries, tasks, todo, stats, time.monotonic() - started)
     _report(summary, config.output, out)
     if stats["lost"]:
         raise FleetFailure(f"{stats['lost']} jobs were lost with the scheduler; run the batch again to finish them")
