@@ -53,8 +53,9 @@ class JournalBusy(Exception):
 
 
 def normalized_row(fields):
-    """A row with every column, in column order; missing values are None."""
-    return {name: fields.get(name) for name in COLUMNS}
+    """A row with every column, in column order; missing values and empty text are None (as an
+    empty CSV cell reads back)."""
+    return {name: (None if fields.get(name) == "" else fields.get(name)) for name in COLUMNS}
 
 
 def is_final(row):
