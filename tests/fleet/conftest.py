@@ -22,7 +22,7 @@ def cli():
     path = os.environ.get("PLIANT_CLI")
     if not path or not os.access(path, os.X_OK):
         pytest.fail("PLIANT_CLI must name the built pliant program (ctest sets it)")
-    return path
+    return os.path.abspath(path)
 
 
 @pytest.fixture(scope="session")

@@ -196,7 +196,7 @@ def test_table_rows_follow_the_batch():
     stored = {"k1": row("k1", recording="where a was", object="old class", msm_beta=0.3), "k9": row("k9")}
     rows = table_rows(entries, stored)
     assert [(r["recording"], r["object"], r["msm_beta"], r["status"]) for r in rows] == \
-        [("a", "foam", 0.3, "ok"), ("copy of a", "foam", 0.3, "ok"), ("b", "", None, "pending")]
+        [("a", "foam", 0.3, "ok"), ("copy of a", "foam", 0.3, "ok"), ("b", None, None, "pending")]
     assert rows[2]["error"].startswith("not run")
     summary = summarize(rows)
     assert summary["jobs"]["diagnose"] == {"rows": 3, "ok": 2, "errors": 0, "pending": 1}
