@@ -49,8 +49,8 @@ BatchCommand::BatchCommand(CLI::App& parent) {
   app_ = parent.add_subcommand("batch",
                                "Run diagnose, refine or estimate over many recordings on Dask distributed, one row "
                                "per recording in a results table (docs/fleet.md; options: pliant batch --help)");
-  app_->set_help_flag();    // --help goes to the fleet, which knows its options
-  app_->prefix_command();   // every argument after `batch` is the fleet's, unparsed
+  app_->set_help_flag();   // --help goes to the fleet, which knows its options
+  app_->prefix_command();  // every argument after `batch` is the fleet's, unparsed
 }
 
 int BatchCommand::run() const { return run_fleet(app_->remaining()); }
@@ -61,10 +61,12 @@ int run_fleet(const std::vector<std::string>& fleet_arguments) {
     throw UsageError(python + " is missing: the fleet needs Debian's python3 and Dask (apt-get install python3 " +
                      "python3-distributed)");
   }
-  const std::vector<std::string> directories = fleet_python_path(std::getenv("PLIANT_PYTHONPATH"), PLIANT_BATCH_PYTHONPATH);
+  const std::vector<std::string> directories =
+      fleet_python_path(std::getenv("PLIANT_PYTHONPATH"), PLIANT_BATCH_PYTHONPATH);
   bool found = false;
   std::error_code error;
-  for (const std::string& directory : directories) found = found || fs::is_regular_file(fs::path(directory) / "pliant" / "fleet.py", error);
+  for (const std::string& directory : directories)
+    found = found || fs::is_regular_file(fs::path(directory) / "pliant" / "fleet.py", error);
   if (!found) {
     throw UsageError("the fleet's Python package (pliant/fleet.py) is in none of " +
                      (directories.empty() ? std::string("(no directory)") : joined(directories, ", ")) +
