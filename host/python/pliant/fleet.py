@@ -357,9 +357,12 @@ def _run_tasks(config, tasks, todo, first_entry, journal, stats):
     written = set()
     progress = Progress(len(todo), len(tasks) - len(todo), not config.quiet)
     try:
-        futures = {}
-        for key in todo:
-            futures[client.submit(fleet_task.run_job, tasks[key], key=f"pliant-{key}", pure=False)] = key
+        # One graph for the whole batch: the scheduler then sees a group of many like tasks and
+        # queues them, handing each worker one at a time (submitted one by one, the first few
+        # would each be sent to a worker at once).
+        submitted_futures = client.map(fleet_task.run_job, [tasks[key] for key in todo],
+                                       key=[f"pliant-{key}" for key in todo], pure=False)
+        futures = dict(zip(submitted_futures, todo))
         for batch in as_completed(list(futures), with_results=False).batches():
             suspicious = _ask_suspicious(client, [future.key for future in batch])
             for future in batch:
