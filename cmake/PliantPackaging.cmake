@@ -78,6 +78,9 @@ if(PLIANT_PYTHON_VERSION)
   set(CPACK_DEBIAN_PYTHON_PACKAGE_DEPENDS
       "python3 (>= ${PLIANT_PYTHON_VERSION}), python3 (<< ${pliant_python_major}.${pliant_python_next_minor}), python3-numpy")
 endif()
+# The fleet (pliant.fleet, docs/fleet.md) runs the command line's jobs on Dask: it works with them
+# installed, and the rest of the module does not need them.
+set(CPACK_DEBIAN_PYTHON_PACKAGE_RECOMMENDS "pliant (= ${PROJECT_VERSION}), python3-distributed, python3-tqdm")
 set(CPACK_COMPONENT_PYTHON_DESCRIPTION
     "pliant for Python: recordings as NumPy arrays, estimate, diagnose, refine, simulate, online estimator, grasp guard")
 

@@ -12,7 +12,9 @@ packages=(
   python3-dev                    # the Python module (host/python): Python's headers
   pybind11-dev                   # the Python module: C++ bindings
   python3-numpy                  # the Python module: recordings as NumPy arrays (also tools/concealed/)
-  python3-pytest                 # the Python module's tests (tests/python)
+  python3-pytest                 # the Python module's and the fleet's tests (tests/python, tests/fleet)
+  python3-distributed            # pliant batch: the fleet on Dask distributed (host/python/pliant/fleet.py)
+  python3-tqdm                   # the fleet's progress bar
   libeigen3-dev                  # core linear algebra (the only core dependency)
   nlohmann-json3-dev             # recording and result JSON (host)
   libcli11-dev                   # the pliant command line

@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli_registry.hpp"
+#include "command_batch.hpp"
 #include "command_devices.hpp"
 #include "command_diagnose.hpp"
 #include "command_estimate.hpp"
@@ -55,6 +56,11 @@ std::vector<AddedCommand> add_optional_commands(CLI::App& app) {
 }
 
 int run(int argc, char** argv) {
+  // `pliant batch ...`: every argument is the fleet's, before CLI11 could read one as ours.
+  if (argc > 1 && std::string(argv[1]) == "batch") {
+    const std::vector<std::string> arguments(argv + 2, argv + argc);
+    return run_reporting_errors("pliant batch", [&] { return run_fleet(arguments); });
+  }
   // A command this build was made without: say so rather than "unknown command".
   if (argc > 1) {
     const std::string missing = missing_command_message(cli_registry(), argv[1]);
@@ -78,6 +84,7 @@ int run(int argc, char** argv) {
   ReplayCommand replay(app);
   DevicesCommand devices(app);
   RecordCommand record(app);
+  BatchCommand batch(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& done) {  // --help, --version
@@ -98,6 +105,7 @@ int run(int argc, char** argv) {
   if (replay.selected()) return run_reporting_errors("pliant replay", [&] { return replay.run(); });
   if (devices.selected()) return run_reporting_errors("pliant devices", [&] { return devices.run(); });
   if (record.selected()) return run_reporting_errors("pliant record", [&] { return record.run(); });
+  if (batch.selected()) return run_reporting_errors("pliant batch", [&] { return batch.run(); });
   std::cerr << app.help();
   return exit_usage;
 }
