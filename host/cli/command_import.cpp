@@ -12,6 +12,7 @@
 #include <system_error>
 #include <vector>
 
+#include "output_directory.hpp"
 #include "exit_status.hpp"
 #include "pliant/host/fem/compression_test.hpp"
 #include "pliant/host/recording.hpp"
@@ -25,17 +26,6 @@ std::string number(double value) {
   char buffer[32];
   std::snprintf(buffer, sizeof buffer, "%.4g", value);
   return buffer;
-}
-
-void check_output_directory(const std::string& directory, bool force) {
-  std::error_code error;
-  const fs::file_status status = fs::status(directory, error);
-  if (!fs::exists(status)) return;
-  if (!fs::is_directory(status)) throw UsageError(directory + " exists and is not a directory");
-  if (force) return;
-  const bool empty = fs::is_empty(directory, error);
-  if (error) throw std::runtime_error("cannot read " + directory + ": " + error.message());
-  if (!empty) throw UsageError(directory + " is not empty; pass --force to replace the recording in it");
 }
 
 // "2,24,5" -> radial, circumferential, axial.

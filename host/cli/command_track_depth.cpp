@@ -10,6 +10,7 @@
 #include <system_error>
 #include <vector>
 
+#include "output_directory.hpp"
 #include "exit_status.hpp"
 #include "track_depth_input.hpp"
 #include "pliant/host/recording.hpp"
@@ -23,17 +24,6 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr int max_rounds = 10;
-
-void check_output_directory(const std::string& directory, bool force) {
-  std::error_code error;
-  const fs::file_status status = fs::status(directory, error);
-  if (!fs::exists(status)) return;
-  if (!fs::is_directory(status)) throw UsageError(directory + " exists and is not a directory");
-  if (force) return;
-  const bool empty = fs::is_empty(directory, error);
-  if (error) throw std::runtime_error("cannot read " + directory + ": " + error.message());
-  if (!empty) throw UsageError(directory + " is not empty; pass --force to replace the recording in it");
-}
 
 std::string number(double value, const char* format = "%.4g") {
   char buffer[32];

@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "output_directory.hpp"
 #include "exit_status.hpp"
 
 namespace pliant::cli {
@@ -14,17 +15,6 @@ namespace fs = std::filesystem;
 
 // Bounds the frame count (and memory) of a scenario a few seconds long.
 constexpr double max_rate_hz = 10000.0;
-
-void check_output_directory(const std::string& directory, bool force) {
-  std::error_code error;
-  const fs::file_status status = fs::status(directory, error);
-  if (!fs::exists(status)) return;
-  if (!fs::is_directory(status)) throw UsageError(directory + " exists and is not a directory");
-  if (force) return;
-  const bool empty = fs::is_empty(directory, error);
-  if (error) throw std::runtime_error("cannot read " + directory + ": " + error.message());
-  if (!empty) throw UsageError(directory + " is not empty; pass --force to replace the recording in it");
-}
 
 std::string number(double value) {
   char buffer[32];
