@@ -330,12 +330,8 @@ MsmFit<Dim> fit_baseline(const Recording& recording, const EstimateOptions& opti
     return between;
   };
 
-  // When the most steps per frame tried fits best, the object moves further between frames than
-  // those steps can follow (it settles within a frame interval: a fast squeeze seen by a slow
-  // camera). Doubles the steps, in the kept variant's msm_alpha modes and radius, while the
-  // doubled count keeps winning, up to max_steps_per_frame.
   // Past the edge the counts tried are a factor of 2 apart: bisects between the kept count and the
-  // nearest counts tried on either side of it (kept modes and radius), a few times.
+  // nearest counts tried on either side of it (kept msm_alpha mode and radius), a few times.
   auto refine_steps_between_doublings = [&]() {
     for (int round = 0; round < kStepBisections; ++round) {
       const BaselineCandidate form = kept();
@@ -361,6 +357,10 @@ MsmFit<Dim> fit_baseline(const Recording& recording, const EstimateOptions& opti
       add(forms);
     }
   };
+  // When the most steps per frame tried fits best, the object moves further between frames than
+  // those steps can follow (it settles within a frame interval: a fast squeeze seen by a slow
+  // camera). Doubles the steps, at the kept variant's radius and in both msm_alpha modes the
+  // options allow, while the doubled count keeps winning, up to max_steps_per_frame.
   auto steps_past_the_edge = [&]() {
     for (int steps = kept().steps_per_frame; steps >= last_steps && steps < max_steps_per_frame;) {
       const int more = std::min(2 * steps, max_steps_per_frame);
@@ -486,6 +486,7 @@ EstimateReport estimate_recording(const Recording& recording, const EstimateOpti
 double BaselineChoice::msm_beta_spread() const {
   if (candidates.size() < 2) return 0.0;
   const BaselineCandidate& kept = candidates[static_cast<std::size_t>(chosen)];
+  if (!std::isfinite(kept.bic)) return 0.0;
   double weights = 0;
   double spread = 0;
   for (const BaselineCandidate& c : candidates) {
