@@ -41,7 +41,7 @@ def python_calls(recording, calls):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("bench", help="the estimate_call_bench program")
-    parser.add_argument("--calls", type=int, default=5, help="calls per round and side")
+    parser.add_argument("--calls", type=int, default=20, help="calls per round and side")
     parser.add_argument("--rounds", type=int, default=3)
     parser.add_argument("--enforce", action="store_true", help="exit 1 over the budget")
     args = parser.parse_args()
