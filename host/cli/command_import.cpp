@@ -12,8 +12,8 @@
 #include <system_error>
 #include <vector>
 
-#include "output_directory.hpp"
 #include "exit_status.hpp"
+#include "output_directory.hpp"
 #include "pliant/host/fem/compression_test.hpp"
 #include "pliant/host/recording.hpp"
 

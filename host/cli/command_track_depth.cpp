@@ -2,16 +2,14 @@
 
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <limits>
 #include <stdexcept>
-#include <system_error>
 #include <vector>
 
-#include "output_directory.hpp"
 #include "exit_status.hpp"
+#include "output_directory.hpp"
 #include "track_depth_input.hpp"
 #include "pliant/host/recording.hpp"
 #include "pliant/vision/depth_recording.hpp"
@@ -20,8 +18,6 @@
 
 namespace pliant::cli {
 namespace {
-
-namespace fs = std::filesystem;
 
 constexpr int max_rounds = 10;
 

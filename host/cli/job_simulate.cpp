@@ -1,17 +1,13 @@
 #include "job_simulate.hpp"
 
 #include <cstdio>
-#include <filesystem>
 #include <stdexcept>
-#include <system_error>
 
-#include "output_directory.hpp"
 #include "exit_status.hpp"
+#include "output_directory.hpp"
 
 namespace pliant::cli {
 namespace {
-
-namespace fs = std::filesystem;
 
 // Bounds the frame count (and memory) of a scenario a few seconds long.
 constexpr double max_rate_hz = 10000.0;

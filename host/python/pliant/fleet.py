@@ -254,22 +254,22 @@ def run_batch(config, out=sys.stdout):
         raise UsageError(str(error)) from None
     except OSError as error:
         raise UsageError(f"cannot write into {config.output}: {error.strerror or error}") from None
-    todo = [key for key in tasks if not _done(journal.rows.get(key), config.retry_errors)]
+    keys_to_run = [key for key in tasks if not _done(journal.rows.get(key), config.retry_errors)]
     stats = {"ran": 0, "lost": 0, "startup_s": 0.0, "run_s": 0.0}
     started = time.monotonic()
     try:
-        if todo:
+        if keys_to_run:
             first_entry = {}
             for entry in entries:
                 first_entry.setdefault(entry["key"], entry)
-            _run_tasks(config, tasks, todo, first_entry, journal, stats)
+            _run_tasks(config, tasks, keys_to_run, first_entry, journal, stats)
     except UsageError:  # no cluster to run on: nothing ran, nothing to write
         journal.close()
         raise
     except BaseException:
-        _finish(config, journal, entries, tasks, todo, stats, time.monotonic() - started)
+        _finish(config, journal, entries, tasks, keys_to_run, stats, time.monotonic() - started)
         raise
-    summary = _finish(config, journal, entries, tasks, todo, stats, time.monotonic() - started)
+    summary = _finish(config, journal, entries, tasks, keys_to_run, stats, time.monotonic() - started)
     _report(summary, config.output, out)
     if stats["lost"]:
         raise FleetFailure(f"{stats['lost']} jobs were lost with the scheduler; run the batch again to finish them")
@@ -290,15 +290,15 @@ def table_rows(entries, journal_rows):
     return rows
 
 
-def _finish(config, journal, entries, tasks, todo, stats, wall_s):
+def _finish(config, journal, entries, tasks, keys_to_run, stats, wall_s):
     """Writes results.csv, results.jsonl and summary.json from the journal, then compacts it."""
     try:
         rows = table_rows(entries, journal.rows)
         summary = summarize(rows, config.class_key)
         summary["batch"] = {
             "recordings": len({entry["recording"] for entry in entries}), "jobs": len(tasks),
-            "ran": stats["ran"], "skipped": len(tasks) - len(todo), "lost": stats["lost"],
-            "not_run": len(todo) - stats["ran"],
+            "ran": stats["ran"], "skipped": len(tasks) - len(keys_to_run), "lost": stats["lost"],
+            "not_run": len(keys_to_run) - stats["ran"],
             "wall_s": round(wall_s, 3), "startup_s": round(stats["startup_s"], 3), "run_s": round(stats["run_s"], 3),
             "jobs_per_s": round(stats["ran"] / stats["run_s"], 4) if stats["ran"] and stats["run_s"] > 0 else None,
             "workers": None if config.scheduler else config.workers, "scheduler": config.scheduler,
@@ -337,8 +337,8 @@ def _done(row, retry_errors):
     return is_final(row) and not retry_errors
 
 
-def _run_tasks(config, tasks, todo, first_entry, journal, stats):
-    """Runs the keys `todo` on the cluster, appending each row to `journal` as it arrives. Counts
+def _run_tasks(config, tasks, keys_to_run, first_entry, journal, stats):
+    """Runs the keys `keys_to_run` on the cluster, appending each row to `journal` as it arrives. Counts
     in `stats` the rows written ("ran"), the tasks lost with the scheduler ("lost": no row, the
     next batch runs them), the cluster's start-up and the time from submission to the last row."""
     try:
@@ -355,14 +355,14 @@ def _run_tasks(config, tasks, todo, first_entry, journal, stats):
     submitted = time.monotonic()
     stats["startup_s"] = submitted - opened
     written = set()
-    progress = Progress(len(todo), len(tasks) - len(todo), not config.quiet)
+    progress = Progress(len(keys_to_run), len(tasks) - len(keys_to_run), not config.quiet)
     try:
         # One graph for the whole batch: the scheduler then sees a group of many like tasks and
         # queues them, handing each worker one at a time (submitted one by one, the first few
         # would each be sent to a worker at once).
-        submitted_futures = client.map(fleet_task.run_job, [tasks[key] for key in todo],
-                                       key=[f"pliant-{key}" for key in todo], pure=False)
-        futures = dict(zip(submitted_futures, todo))
+        submitted_futures = client.map(fleet_task.run_job, [tasks[key] for key in keys_to_run],
+                                       key=[f"pliant-{key}" for key in keys_to_run], pure=False)
+        futures = dict(zip(submitted_futures, keys_to_run))
         for batch in as_completed(list(futures), with_results=False).batches():
             suspicious = _ask_suspicious(client, [future.key for future in batch])
             for future in batch:
