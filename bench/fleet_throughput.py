@@ -48,7 +48,7 @@ def main():
     args = parser.parse_args()
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join(filter(None, [os.environ.get("PLIANT_PYTHONPATH",
-                                                                     os.path.join(REPO, "host", "python")),
+                                                                     os.path.join(REPO, "build", "python")),
                                                       os.environ.get("PYTHONPATH")]))
     with tempfile.TemporaryDirectory(prefix="pliant-fleet-bench-") as scratch:
         recordings = os.path.join(scratch, "recordings")

@@ -1,7 +1,7 @@
 """Shared helpers of the fleet tests: the pliant program, simulated recordings, running a batch.
 
 ctest sets PLIANT_CLI (the built pliant), PLIANT_EXAMPLES_DIR and PYTHONPATH (the package
-directory); by hand: PLIANT_CLI=build/bin/pliant PLIANT_EXAMPLES_DIR=examples PYTHONPATH=host/python
+directory); by hand: PLIANT_CLI=build/bin/pliant PLIANT_EXAMPLES_DIR=examples PYTHONPATH=build/python
 /usr/bin/python3 -m pytest tests/fleet
 """
 
