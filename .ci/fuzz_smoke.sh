@@ -17,11 +17,56 @@
 # PLIANT_CSV_FUZZ_SECONDS (default 30), PLIANT_TELEMETRY_FUZZ_SECONDS (default 20),
 # PLIANT_FUZZ_BUILD_DIR (default build-fuzz), CXX_FUZZ (default clang++), CC_FUZZ (default
 # clang: the telemetry codec is C).
+#
+# The fuzzers run in the background, ${PLIANT_FUZZ_JOBS:-$(nproc)} at a time (each is one process on
+# one core), each into build-fuzz/fuzz/logs/<fuzzer>.log; a finished one prints its final stats,
+# a failed one the end of its log. The script exits non-zero when any failed.
 set -euo pipefail
 
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${PLIANT_FUZZ_BUILD_DIR:-$root/build-fuzz}"
 seconds="${PLIANT_FUZZ_SECONDS:-60}"
+
+fuzz_jobs="${PLIANT_FUZZ_JOBS:-$(nproc)}"
+fuzz_logs="$build/fuzz/logs"
+declare -A fuzz_running=()  # pid -> fuzzer name
+fuzz_failed=()
+trap 'kill "${!fuzz_running[@]}" 2> /dev/null || true' EXIT
+
+# Waits for one running fuzzer and reports it.
+fuzz_reap_one() {
+  local pid status=0 name
+  wait -n -p pid "${!fuzz_running[@]}" || status=$?
+  name=${fuzz_running[$pid]}
+  unset "fuzz_running[$pid]"
+  if [ "$status" -eq 0 ]; then
+    echo "== fuzz $name: passed ($(grep -E '^stat::number_of_executed_units' "$fuzz_logs/$name.log" | tr -d ' '))"
+  else
+    echo "== fuzz $name: FAILED (exit $status); end of $fuzz_logs/$name.log:"
+    tail -n 80 "$fuzz_logs/$name.log"
+    fuzz_failed+=("$name")
+  fi
+}
+
+# fuzz_run FUZZER ARGS...: starts the fuzzer in the background once a slot is free.
+fuzz_run() {
+  local name
+  name=$(basename "$1")
+  while [ "${#fuzz_running[@]}" -ge "$fuzz_jobs" ]; do fuzz_reap_one; done
+  echo "== fuzz $name: started"
+  "$@" > "$fuzz_logs/$name.log" 2>&1 &
+  fuzz_running[$!]=$name
+}
+
+# Waits for every fuzzer; fails when one did.
+fuzz_wait_all() {
+  while [ "${#fuzz_running[@]}" -gt 0 ]; do fuzz_reap_one; done
+  if [ "${#fuzz_failed[@]}" -gt 0 ]; then
+    echo "fuzz smoke: ${#fuzz_failed[@]} fuzzer(s) failed: ${fuzz_failed[*]}" >&2
+    return 1
+  fi
+  echo "fuzz smoke: every fuzzer passed"
+}
 
 # -O1 with line tables: libFuzzer's recommended optimisation, file and line in every report, and
 # less compile time than -O2 -g.
@@ -36,6 +81,8 @@ cmake -S "$root" -B "$build" \
   -DPLIANT_BUILD_HOST=OFF \
   -DPLIANT_BUILD_BENCHMARKS=OFF
 cmake --build "$build" --target recording_fuzz mesh_fuzz compression_csv_fuzz telemetry_fuzz fault_script_fuzz -j "$(nproc)"
+rm -rf "$fuzz_logs"
+mkdir -p "$fuzz_logs"
 
 fuzzer="$build/bin/recording_fuzz"
 [ -x "$fuzzer" ] || fuzzer="$(find "$build" -type f -name recording_fuzz -perm -u+x | head -n 1)"
@@ -56,7 +103,7 @@ printf '%s\0%b' "$json2d" "$csv2d" > "$corpus/seed-2d"
 printf '%s\0%b\0%b\0%b\0%b' "$json3d" "$csv3d" "$classic" "$wrench" "$gripper" > "$corpus/seed-3d-classic"
 printf '%s\0%b\0%b' "$json3d" "$csv3d" "$offsets" > "$corpus/seed-3d-offsets"
 
-"$fuzzer" "$corpus" \
+fuzz_run "$fuzzer" "$corpus" \
   -dict="$root/tests/fuzz/recording_fuzz.dict" \
   -max_total_time="$seconds" \
   -max_len=8192 \
@@ -109,7 +156,7 @@ printf '\4solid t\nfacet normal 0 0 -1\nouter loop\nvertex 0 0 0\nvertex 0 1 0\n
   printf '\0\0'
 } > "$mesh_corpus/seed-stl-binary"
 
-"$mesh_fuzzer" "$mesh_corpus" \
+fuzz_run "$mesh_fuzzer" "$mesh_corpus" \
   -dict="$root/tests/fuzz/mesh_fuzz.dict" \
   -max_total_time="${PLIANT_MESH_FUZZ_SECONDS:-30}" \
   -max_len=8192 \
@@ -129,7 +176,7 @@ head -n 40 "$root/examples/phantom_compression/source/EF10_0T_B5.csv" > "$csv_co
 printf '\357\273\277Sample: cyl-7;\r\nDiameter (mm): 50\r\nheight: 0.03 m\r\nSpeed: 0.5 mm/s\r\nLoad cell: 1kN\r\nTime (ms),Load (kN),Compression (m),Note,True Stress (MPa)\r\n0,0,0,a,0\r\n500,0.002,0.001,b,0.1\r\n1000,0.004,0.002,c,0.2\r\n' \
   > "$csv_corpus/seed-units"
 
-"$csv_fuzzer" "$csv_corpus" \
+fuzz_run "$csv_fuzzer" "$csv_corpus" \
   -max_total_time="${PLIANT_CSV_FUZZ_SECONDS:-30}" \
   -max_len=8192 \
   -timeout=10 \
@@ -151,7 +198,7 @@ printf '\x00\x03\x01\x01\x01\x03\xe8\x03\x01\x01\x01\x01\x01\x01\x01\x01\x01\x01
 printf '\x07\x03\x41\x42\x00\x04\x01\x03\x04\x03\x88\x13\x01\x01\x01\x01\x01\x02\x01\x01\x01\x02\x03\x02\x0c\x01\x01\x02\x04\x0d\x6f\x12\x03\xba\x6f\x12\x03\x3a\xa6\x9b\xc4\x3a\x0d\xe3\xa5\x1b\x3c\x31\x08\x2c\x3c\x7f\x6a\x3c\x3c\x0d\x77\xbe\x9f\x3c\x9e\xef\xa7\x3c\xc5\x20\xb0\x3c\x10\xfc\xa9\xf1\x3c\x23\xdb\xf9\x3c\x24\x06\x01\x3d\x01\x3d\x9c\x00\x04\x01\x03\x05\x03\x88\x13\x01\x01\x01\x01\x01\x02\x01\x01\x01\x02\x03\x02\x0c\x02\x04\x02\x04\x0d\xc0\xca\x21\x3d\x53\xe3\x25\x3d\xe7\xfb\x29\x3d\x1a\x82\xc0\x4a\x3d\x15\xd9\x4e\x3d\xa9\xf1\x52\x3d\x02\x45\xb6\x73\x3d\xd8\xce\x77\x3d\x6c\xe7\x7b\x3d\x0d\x04\x56\x8e\x3d\x4e\x62\x90\x3d\x97\x6e\x92\x3d\x03\x44\x4d\x00\x04\x01\x03\x06\x03\x88\x13\x01\x01\x01\x01\x01\x02\x01\x01\x01\x02\x03\x02\x0c\x02\x08\x02\x04\x0d\xe5\xd0\xa2\x3d\x2f\xdd\xa4\x3d\x78\xe9\xa6\x3d\x0d\xc6\x4b\xb7\x3d\x10\x58\xb9\x3d\x59\x64\xbb\x3d\x1a\xa7\xc6\xcb\x3d\xf1\xd2\xcd\x3d\x3a\xdf\xcf\x3d\x01\x89\x41\xe0\x3d\xd3\x4d\xe2\x3d\x1c\x5a\xe4\x3d\x03\xbe\xfe\x00\x04\x01\x09\x28\x03\xe8\x03\x01\x01\x01\x01\x01\x06\x01\x02\x03\x72\x43\x00\x04\x02\x01\x29\x03\xe8\x03\x01\x01\x01\x01\x01\x20\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\x22\xf2\x4e\x00' > "$telemetry_corpus/seed-chunks-garbage"
 printf '\x01\x04\x01\x04\x07\x03\x70\x17\x01\x01\x01\x01\x01\x02\x03\x02\x01\x02\x01\x01\x01\x02\x02\x02\x02\x01\x01\x02\x03\x02\x03\x01\x01\x03\x71\x27\x00\x04\x01\x02\x08\x03\x58\x1b\x01\x01\x01\x01\x01\x05\x01\x0e\x01\x04\x02\x50\x01\x01\x01\x01\x01\x05\x6f\x12\x83\x3b\x01\x07\xf0\x40\xcd\xcc\x4c\x3d\x01\x13\xe0\x40\x8f\xc2\x75\x3d\x42\x60\x65\x3b\xe7\xfb\x29\x3d\xcd\xcc\xdc\x40\x01\x03\x80\x3e\x01\x01\x04\x3f\x7d\xd1\x00\x04\x01\x01\x09\x03\x40\x1f\x01\x01\x01\x01\x01\x01\x01\x01\x01\x01\x01\x03\xd8\x3f\x01\x01\x01\x01\x01\x0e\xb0\x3f\x61\x32\x55\x30\x2a\xa9\x23\x3f\x40' > "$telemetry_corpus/seed-damaged"
 
-"$telemetry_fuzzer" "$telemetry_corpus" \
+fuzz_run "$telemetry_fuzzer" "$telemetry_corpus" \
   -dict="$root/tests/fuzz/telemetry_fuzz.dict" \
   -max_total_time="${PLIANT_TELEMETRY_FUZZ_SECONDS:-20}" \
   -max_len=8192 \
@@ -171,7 +218,7 @@ printf '# faults\n1.2 timeout gripper 0.05\r\n1.5\tbus_off ft 0.02 # CAN\n2 faul
   > "$fault_corpus/seed-kinds"
 printf '1 drop gripper\nx nan ft 1\n1 bus_off gripper 1\n1 occlude observer 0.1 2\n' > "$fault_corpus/seed-malformed"
 
-"$fault_fuzzer" "$fault_corpus" \
+fuzz_run "$fault_fuzzer" "$fault_corpus" \
   -max_total_time="${PLIANT_FAULT_FUZZ_SECONDS:-15}" \
   -max_len=4096 \
   -timeout=10 \
@@ -189,3 +236,4 @@ for fragment in "$root"/.ci/fuzz.d/*.sh; do
   # shellcheck source=/dev/null
   source "$fragment"
 done
+fuzz_wait_all

@@ -10,7 +10,7 @@ mkdir -p "$device_spec_corpus" "$device_spec_artifacts"
 printf 'slave=9\nbase=0x20\nrate=100.5\nstream=yes\nformat=bgr8\n' > "$device_spec_corpus/seed-valid"
 printf 'slave=0x-1\nbase=0x\nrate=nan\nstream=maybe\nformat=\n=\n' > "$device_spec_corpus/seed-malformed"
 printf 'a=99999999999999999999\nb=1e999\nc=-0\nd=0X10\n' > "$device_spec_corpus/seed-ranges"
-"$device_spec_fuzzer" "$device_spec_corpus" \
+fuzz_run "$device_spec_fuzzer" "$device_spec_corpus" \
   -max_total_time="${PLIANT_DEVICE_SPEC_FUZZ_SECONDS:-10}" \
   -max_len=1024 \
   -timeout=10 \

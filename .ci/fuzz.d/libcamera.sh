@@ -22,7 +22,7 @@ else
   { printf '\x00\x02\x02\x02\x03\x00\x00\x00'; printf "$(libcamera_bytes 36)"; } > "$libcamera_corpus/seed-rgb888"
   { printf '\x03\x00\x01\x01\x00\x00\x08\x00'; printf "$(libcamera_bytes 16)"; } > "$libcamera_corpus/seed-xbgr-short"
   { printf '\x07\x00\x03\x01\x00\x08\x00\x00'; printf "$(libcamera_bytes 12)"; } > "$libcamera_corpus/seed-nv21-error"
-  "$libcamera_fuzzer" "$libcamera_corpus" \
+  fuzz_run "$libcamera_fuzzer" "$libcamera_corpus" \
     -max_total_time="${PLIANT_LIBCAMERA_FUZZ_SECONDS:-10}" \
     -max_len=20000 \
     -timeout=10 \

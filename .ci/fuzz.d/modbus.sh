@@ -23,7 +23,7 @@ else
   printf '\x00\x00\x00\x00\x00\x00\x34\x40\x00\x00\x00\x00\x00\x60\x6d\x40\x7b\x14\xae\x47\xe1\x7a\xa4\x3f' >> "$robotiq_corpus/seed-manual"
   printf '\x9a\x99\x99\x99\x99\x99\xb9\x3f\x00\x00\x00\x00\x00\x00\x49\x40\x03\xe6' >> "$robotiq_corpus/seed-manual"
   head -c 90 /dev/zero | tr '\0' '\377' > "$robotiq_corpus/seed-ones"
-  "$robotiq_fuzzer" "$robotiq_corpus" \
+  fuzz_run "$robotiq_fuzzer" "$robotiq_corpus" \
     -max_total_time="$modbus_seconds" \
     -max_len=256 \
     -timeout=10 \
@@ -42,7 +42,7 @@ else
   printf "\\x04${modbus_frame}${modbus_frame}" > "$stream_corpus/seed-clean"
   printf "\\x00\\x09\\x10\\x01\\x9a\\x00\\x01\\x20\\x4e\\x20\\x4e\\x64\\x00\\x9c${modbus_frame}\\x20\\x4e\\x65\\x00\\x9c\\xff\\xd2\\x04\\xff\\xff\\x00\\x00\\xff\\x7f\\x59\\x18${modbus_frame}" > "$stream_corpus/seed-damaged"
   { printf '\x10'; head -c 50 /dev/zero | tr '\0' '\377'; } > "$stream_corpus/seed-jam"
-  "$stream_fuzzer" "$stream_corpus" \
+  fuzz_run "$stream_fuzzer" "$stream_corpus" \
     -max_total_time="$modbus_seconds" \
     -max_len=4096 \
     -timeout=10 \

@@ -17,7 +17,7 @@ else
   printf '\x0eframe_%%04d.pngframe_10.png' > "$opencv_corpus/seed-pattern"
   printf '\x0d100%%%%_%%3i.jpgimg_2.JPG' > "$opencv_corpus/seed-escape"
   printf '\x09%%d_%%d.pngnotes.txt' > "$opencv_corpus/seed-two"
-  "$opencv_fuzzer" "$opencv_corpus" \
+  fuzz_run "$opencv_fuzzer" "$opencv_corpus" \
     -max_total_time="${PLIANT_OPENCV_FUZZ_SECONDS:-10}" \
     -max_len=512 \
     -timeout=10 \

@@ -43,7 +43,7 @@ else
   oni_tiny 1 > "$oni_corpus/seed-tiny"
   oni_tiny 0 > "$oni_corpus/seed-tiny-narrow"
   cp "$root/tests/data/oni_kinect/room.oni" "$oni_corpus/seed-room"
-  "$oni_fuzzer" "$oni_corpus" \
+  fuzz_run "$oni_fuzzer" "$oni_corpus" \
     -max_total_time="$openni2_seconds" \
     -max_len=65536 \
     -timeout=10 \
@@ -65,7 +65,7 @@ else
   printf '\xe8\x03\x00\x00\xd0\x07\x00\x00\xff\xff\x00\x00\x01\x00\x02\x00\x03\x00\x00\x00\x00\x00\xff\xff\x10\x27\x00\x00\x00\x00\x00\x00' >> "$depth_corpus/seed-4x3"
   printf "\\x02\\x00\\x02\\x00\\x04\\x00$(le32 0x3a83126f)$(le32 0x7fc00000)$(le32 0x43960000)$(le32 0)$(le32 0)\\x83$(le32 0)$(le32 0)\\xe8\\x03\\x00\\x00\\x00\\x00\\xd0\\x07" > "$depth_corpus/seed-nan"
   printf '\x00\x00\x00\x00' > "$depth_corpus/seed-empty"
-  "$depth_fuzzer" "$depth_corpus" \
+  fuzz_run "$depth_fuzzer" "$depth_corpus" \
     -max_total_time="$openni2_seconds" \
     -max_len=4096 \
     -timeout=10 \

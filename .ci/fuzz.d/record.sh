@@ -28,7 +28,7 @@ else
   printf '\002ati-can:can0@0x80' > "$record_corpus/seed-bad-base"
   printf '\003robotiq-tcp:localhost:0@300' > "$record_corpus/seed-bad-tcp"
   printf '\000v4l2:\n\377' > "$record_corpus/seed-bad-control"
-  "$record_fuzzer" "$record_corpus" \
+  fuzz_run "$record_fuzzer" "$record_corpus" \
     -max_total_time="${PLIANT_RECORD_FUZZ_SECONDS:-10}" \
     -max_len=4200 \
     -timeout=10 \

@@ -25,7 +25,7 @@ if cmake --build "$build" --target help 2>/dev/null | grep 'vision_depth_fuzz' >
   printf '\00410,20,30,40' > "$depth_corpus/seed-region"
   printf '\0041.5,0,1,1' > "$depth_corpus/seed-region-bad"
 
-  "$depth_fuzzer" "$depth_corpus" \
+  fuzz_run "$depth_fuzzer" "$depth_corpus" \
     -max_total_time="${PLIANT_DEPTH_FUZZ_SECONDS:-10}" \
     -max_len=4096 \
     -timeout=10 \

@@ -20,7 +20,7 @@ else
     printf '\100\001\002\003'; } > "$webcam_corpus/seed-mask"
   printf '1,2,-3\n0x8\n1,,2\nnan,1\nlk\n' > "$webcam_corpus/seed-malformed"
   printf '0,0,40,30\n\n3,1\n7\ndis\n\010\377\377\377\377\377\377\377\377' > "$webcam_corpus/seed-ids"
-  "$webcam_fuzzer" "$webcam_corpus" \
+  fuzz_run "$webcam_fuzzer" "$webcam_corpus" \
     -max_total_time="${PLIANT_WEBCAM_FUZZ_SECONDS:-10}" \
     -max_len=4096 \
     -timeout=10 \
