@@ -46,7 +46,8 @@ set(PLIANT_FEM_ESTIMATION_SOURCES
   ${pliant_host_src}/fem_estimation/estimate_static.cpp
   ${pliant_host_src}/fem_estimation/estimate_dynamic.cpp
   ${pliant_host_src}/fem_estimation/estimate_dynamic_modal.cpp
-  ${pliant_host_src}/fem_estimation/estimate_rest_shape.cpp)
+  ${pliant_host_src}/fem_estimation/estimate_rest_shape.cpp
+  ${pliant_host_src}/fem_estimation/material_map_selection.cpp)
 # importers of outside datasets: compression tests (fem/compression_test.hpp)
 set(PLIANT_DATASETS_SOURCES
   ${pliant_host_src}/datasets/compression_test_csv.cpp

@@ -58,8 +58,9 @@ RefineCommand::RefineCommand(CLI::App& parent) {
                    "Start of the youngs_modulus fit in Pa (> 0; default: the recording's value, else 1e5)")
       ->type_name("PA");
   app_->add_option("--control-points", control_points_,
-                   "material_map: N points spread over the mesh (1-64), or FILE with one 'x,y,z' (m) per line")
-      ->type_name("N|FILE")
+                   "material_map: auto (as many as the data determine: 1, 2, 4, ... points, the lowest BIC), N points "
+                   "spread over the mesh (1-64), or FILE with one 'x,y,z' (m) per line")
+      ->type_name("auto|N|FILE")
       ->capture_default_str();
   app_->add_option("--rest-frame", rest_frame_, "rest_shape: the frame holding the body at rest under gravity")
       ->type_name("K")

@@ -30,7 +30,7 @@ class RefineCommand {
   double max_strain_ = 0.10;
   bool no_force_offset_ = false;
   double initial_modulus_pa_ = 0;
-  std::string control_points_ = "4";
+  std::string control_points_ = "auto";
   int rest_frame_ = 0;
   std::string rest_mesh_path_;
   double until_s_ = 0;

@@ -93,7 +93,7 @@ ControlPointSource check_options(const RefineJob& job, RefineRequest& request) {
   if (substeps < 1 || substeps > 64) throw UsageError("--substeps must be between 1 and 64");
   if (job.threads < 0 || job.threads > 256) throw UsageError("--threads must be between 0 and 256");
   if (job.rest_frame.value_or(0) < 0) throw UsageError("--rest-frame must be >= 0");
-  const ControlPointSource control = parse_control_points(job.control_points.value_or("4"));
+  const ControlPointSource control = parse_control_points(job.control_points.value_or("auto"));
   if (writes_card(job)) check_output_file(job.json, "--json");
   if (!job.vtk.empty()) check_output_directory(job.vtk, "--vtk");
   return control;
@@ -163,13 +163,14 @@ RefineSettings refine_settings(const RefineJob& job, const RefinePlan& plan,
       throw UsageError("--control-points " + std::to_string(control.count) + " exceeds the mesh's " +
                        std::to_string(problem.mesh.tet_count()) + " tetrahedra");
     }
+    settings.select_control_points = control.automatic;
     settings.control_point_count = control.count;
     settings.control_points_m = control.points_m;
     if (!control.points_m.empty()) {
       try {
         const host::fem::MaterialMap check(problem.mesh, control.points_m);
       } catch (const std::invalid_argument& e) {
-        throw UsageError("--control-points " + job.control_points.value_or("4") + ": " + e.what());
+        throw UsageError("--control-points " + job.control_points.value_or("auto") + ": " + e.what());
       }
     }
   }
@@ -216,6 +217,7 @@ RefineDone run_refine_job(const RefineJob& job, const RecordingSource& source, c
   report.outcome = &outcome;
   report.mesh_source = mesh_source;
   if (plan.rest_shape) report.rest_shape_ref = card_reference(done.rest_mesh, job.json);
+  for (const std::string& warning : outcome.warnings) warn(warning);
   if (!outcome.converged) {
     warn("the fit did not converge" + (outcome.fit_message.empty() ? std::string() : ": " + outcome.fit_message) +
          " (see diagnostics in the card)");

@@ -24,7 +24,7 @@ struct RefineJob {
   std::optional<double> max_strain;           ///< --max-strain E, (0, 1]; default 0.10
   bool no_force_offset = false;               ///< --no-force-offset
   std::optional<double> initial_modulus;      ///< --initial-modulus PA, > 0
-  std::optional<std::string> control_points;  ///< --control-points N|FILE; default "4"
+  std::optional<std::string> control_points;  ///< --control-points auto|N|FILE; default "auto"
   std::optional<int> rest_frame;              ///< --rest-frame K, >= 0; default 0
   std::optional<std::string> rest_mesh;       ///< --rest-mesh FILE
   std::optional<double> until;                ///< --until S

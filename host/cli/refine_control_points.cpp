@@ -45,6 +45,10 @@ bool parse_point(const std::string& line, Eigen::Vector3d& point) {
 
 ControlPointSource parse_control_points(const std::string& value) {
   ControlPointSource source;
+  if (value == "auto") {
+    source.automatic = true;
+    return source;
+  }
   if (all_digits(value)) {
     if (value.size() > 3 || std::stoi(value) < 1 || std::stoi(value) > kMaxControlPoints) {
       throw UsageError("--control-points must be between 1 and " + std::to_string(kMaxControlPoints) + " (got " +

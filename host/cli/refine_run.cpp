@@ -11,6 +11,7 @@
 #include "pliant/host/fem/estimate_dynamic.hpp"
 #include "pliant/host/fem/estimate_static.hpp"
 #include "pliant/host/fem/material_map.hpp"
+#include "pliant/host/fem/material_map_selection.hpp"
 
 namespace pliant::cli {
 namespace {
@@ -131,6 +132,31 @@ std::pair<double, double> map_mean(const FemRecordingProblem& problem, const Mat
   return {mean, variance >= 0 ? mean * std::sqrt(variance) : kNaN};
 }
 
+// What the control-point selection tried and chose (card diagnostics "material_map_selection"),
+// and a warning per control point the data do not determine.
+void report_selection(const MaterialMapSelection& selection, RefineOutcome& out) {
+  nlohmann::json tried = nlohmann::json::array();
+  for (const MaterialMapCandidate& c : selection.candidates) {
+    tried.push_back({{"control_points", c.control_points},
+                     {"parameters", c.parameters},
+                     {"rms", number(c.residual_rms_m * std::sqrt(3.0))},
+                     {"lag1_correlation", number(c.lag1_correlation)},
+                     {"bic", number(c.bic)},
+                     {"converged", c.converged}});
+  }
+  const MaterialMapCandidate& chosen = selection.candidates[static_cast<std::size_t>(selection.chosen)];
+  out.diagnostics["material_map_selection"] = {{"tried", tried},
+                                               {"chosen_control_points", chosen.control_points},
+                                               {"design_effect", number(selection.design_effect)},
+                                               {"undetermined", selection.undetermined}};
+  for (int i : selection.undetermined) {
+    const Eigen::Vector3d& p = selection.estimate.control_points_m[static_cast<std::size_t>(i)];
+    out.warnings.push_back("material_map: control point " + std::to_string(i) + " at (" + std::to_string(p.x()) + ", " +
+                           std::to_string(p.y()) + ", " + std::to_string(p.z()) +
+                           ") m is not determined by the data (its modulus is unreliable)");
+  }
+}
+
 void run_trajectory(const FemRecordingProblem& problem, const RefinePlan& plan, const RefineSettings& s,
                     RefineProgress& progress, RefineOutcome& out) {
   TrajectoryEstimateOptions o;
@@ -141,12 +167,21 @@ void run_trajectory(const FemRecordingProblem& problem, const RefinePlan& plan, 
   o.simulation.substeps = s.substeps;
   o.threads = s.threads;
   o.fit.on_iteration = reporter(progress);
-  if (plan.material_map) {
+  const bool select = plan.material_map && s.select_control_points;
+  if (plan.material_map && !select) {
     o.control_points_m =
         s.control_points_m.empty() ? place_control_points(problem.mesh, s.control_point_count) : s.control_points_m;
   }
-  progress.stage("trajectory estimator, modal warm start and fit");
-  const TrajectoryEstimate e = estimate_trajectory_parameters(problem, o);
+  MaterialMapSelection selection;
+  if (select) {
+    progress.stage("trajectory estimator: material maps of 1, 2, 4, ... control points");
+    selection = select_material_map(problem, o);
+    o.control_points_m = selection.estimate.control_points_m;
+    report_selection(selection, out);
+  } else {
+    progress.stage("trajectory estimator, modal warm start and fit");
+  }
+  const TrajectoryEstimate e = select ? std::move(selection.estimate) : estimate_trajectory_parameters(problem, o);
 
   const int k = static_cast<int>(e.control_youngs_modulus_pa.size());
   if (plan.material_map) {

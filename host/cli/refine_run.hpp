@@ -40,6 +40,7 @@ struct RefineSettings {
   double max_strain = 0.10;                       ///< reaction: frames up to this nominal strain; >= 1: all
   bool force_offset = true;                       ///< reaction: fit a constant force offset (toe)
   double initial_youngs_modulus_pa = 0;           ///< start; 0: recording's value or 1e5 Pa
+  bool select_control_points = true;              ///< material_map: the count chosen by the data
   int control_point_count = 4;                    ///< material_map: placed by place_control_points
   std::vector<Eigen::Vector3d> control_points_m;  ///< material_map: given (overrides the count)
   int rest_frame = 0;                             ///< rest_shape: the static frame
@@ -59,6 +60,9 @@ struct RefineOutcome {
   std::map<std::string, double> uncertainty;  ///< 1 sd; NaN when the data do not determine it
   /// Values the model used that the recording does not give and refine did not estimate.
   std::map<std::string, double> assumed;
+
+  /// Said to the user after the run (e.g. control points the data do not determine).
+  std::vector<std::string> warnings;
 
   bool has_map = false;
   std::vector<Eigen::Vector3d> control_points_m;

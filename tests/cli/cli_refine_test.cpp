@@ -223,6 +223,31 @@ TEST(cli_refine, TwoPointMaterialMapFromAControlPointFile) {
   EXPECT_FALSE(card.at("uncertainty").contains("rayleigh_alpha"));
 }
 
+// The default --control-points auto: the card says which counts were tried and which was kept.
+TEST(cli_refine, MaterialMapCountChosenByTheDataIsReportedInTheCard) {
+  TempDir dir;
+  const host::fem::BarVibrationScenario bar = make_coarse_bar({3e5, 1.2e6});
+  host::Recording recording = bar.recording;
+  recording.material["rayleigh_alpha"] = bar.rayleigh_alpha;
+  recording.material["rayleigh_beta"] = bar.rayleigh_beta;
+  const fs::path rec = dir.path() / "bar";
+  host::write_recording(recording, rec.string());
+  const CommandResult r = run_pliant("refine " + quoted(rec.string()) + " -q --estimate material_map --json -");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json card = nlohmann::json::parse(r.out);
+  expect_card_follows_spec(card, read_json(rec / "recording.json"));
+  const nlohmann::json& selection = card.at("diagnostics").at("material_map_selection");
+  std::printf("[ refine ] auto control points: %s\n", selection.dump().c_str());
+  const nlohmann::json& tried = selection.at("tried");
+  ASSERT_GE(tried.size(), 2u);
+  EXPECT_EQ(tried.at(0).at("control_points"), 1);
+  EXPECT_EQ(tried.at(1).at("control_points"), 2);
+  const int chosen = selection.at("chosen_control_points").get<int>();
+  EXPECT_GE(chosen, 2) << "the bar is two materials";
+  EXPECT_EQ(card.at("material_map").at("youngs_modulus").size(), static_cast<std::size_t>(chosen));
+  EXPECT_TRUE(selection.at("undetermined").is_array());
+}
+
 TEST(cli_refine, RestShapeOfASaggingCantileverIsWrittenBesideTheCard) {
   TempDir dir;
   const SagCase sag = make_sag_case();
@@ -275,8 +300,9 @@ TEST(cli_refine, MeshFileStandsInForAMissingRecordingMesh) {
 TEST(cli_refine, HelpNamesTheEstimatorsUnitsAndDefaults) {
   const CommandResult r = run_pliant("refine --help");
   ASSERT_EQ(r.status, 0) << r.err;
-  for (const char* text : {"--estimate", "--mesh", "--json", "--vtk", "--max-strain E=0.1", "--control-points N|FILE=4",
-                           "reaction", "force", "trajectory", "rest_shape", "Units: m, s, Pa, N"}) {
+  for (const char* text :
+       {"--estimate", "--mesh", "--json", "--vtk", "--max-strain E=0.1", "--control-points auto|N|FILE=auto",
+        "reaction", "force", "trajectory", "rest_shape", "Units: m, s, Pa, N"}) {
     EXPECT_TRUE(contains(r.out, text)) << text;
   }
   EXPECT_TRUE(contains(run_pliant("--help").out, "refine"));

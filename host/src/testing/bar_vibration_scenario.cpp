@@ -44,6 +44,18 @@ double max_node_displacement(const FemModel& model, const Eigen::VectorXd& posit
   return largest;
 }
 
+/// Per-tetrahedron modulus of k equal slabs along x in [0, length].
+Eigen::VectorXd slab_values(const TetMesh& mesh, double length, const std::vector<double>& slab_moduli_pa) {
+  const std::vector<Eigen::Vector3d> centroids = element_centroids(mesh);
+  const int k = static_cast<int>(slab_moduli_pa.size());
+  Eigen::VectorXd values(static_cast<Eigen::Index>(centroids.size()));
+  for (std::size_t e = 0; e < centroids.size(); ++e) {
+    const int slab = std::clamp(static_cast<int>(std::floor(centroids[e].x() / length * k)), 0, k - 1);
+    values[static_cast<Eigen::Index>(e)] = slab_moduli_pa[uz(slab)];
+  }
+  return values;
+}
+
 }  // namespace
 
 std::vector<int> box_surface_nodes(const TetMesh& mesh) {
@@ -81,8 +93,12 @@ BarVibrationScenario make_bar_vibration_scenario(const BarVibrationOptions& opti
   scenario.control_youngs_modulus_pa = options.control_youngs_modulus_pa;
   scenario.rayleigh_alpha = options.rayleigh_alpha;
   scenario.rayleigh_beta = options.rayleigh_beta;
-  const MaterialMap map(mesh, scenario.control_points_m, options.material_map);
-  scenario.element_youngs_modulus_pa = map.element_values(options.control_youngs_modulus_pa);
+  if (options.slabs) {
+    scenario.element_youngs_modulus_pa = slab_values(mesh, length, options.control_youngs_modulus_pa);
+  } else {
+    const MaterialMap map(mesh, scenario.control_points_m, options.material_map);
+    scenario.element_youngs_modulus_pa = map.element_values(options.control_youngs_modulus_pa);
+  }
 
   FemMaterial material;
   material.youngs_modulus_pa = options.control_youngs_modulus_pa.front();
@@ -168,7 +184,11 @@ BarVibrationScenario make_bar_vibration_scenario(const BarVibrationOptions& opti
   truth["youngs_modulus"] = options.control_youngs_modulus_pa;
   truth["rayleigh_alpha"] = options.rayleigh_alpha;
   truth["rayleigh_beta"] = options.rayleigh_beta;
-  truth["kernel_width_m"] = map.kernel_width_m();
+  if (options.slabs) {
+    truth["slabs"] = static_cast<int>(options.control_youngs_modulus_pa.size());
+  } else {
+    truth["kernel_width_m"] = MaterialMap(mesh, scenario.control_points_m, options.material_map).kernel_width_m();
+  }
   nlohmann::json generator = nlohmann::json::object();
   generator["scenario"] = "cantilever bar released from a static end load (Wang et al. 2015, Table 1)";
   generator["integrator"] = "newmark";

@@ -17,8 +17,9 @@
 // horizontal soft bar of this size would sag by more than its length.
 //
 // Material: control points on the bar's axis at x = (i + 1/2) L / k, i = 0..k-1 (i = 0 next to the
-// clamp), with the given moduli, interpolated to the elements by MaterialMap. One value gives a
-// uniform bar.
+// clamp), with the given moduli, interpolated to the elements by MaterialMap; or, with `slabs`,
+// k slabs of equal length with those moduli (a bar of glued blocks: a field no control-point map
+// represents exactly). One value gives a uniform bar.
 //
 // The generated data, and how they avoid the "inverse crime" (the estimator fitting data made
 // by its own discretisation): the load is a force and torque spread over the end face
@@ -61,6 +62,9 @@ struct BarVibrationOptions {
   /// bar {1e5, 1e6, 1e4, 6.8e5, 2e6, 7e4, 1e7, 3e4}).
   std::vector<double> control_youngs_modulus_pa{6.8e5};
   MaterialMapOptions material_map;
+  /// true: the k moduli are k slabs of equal length along x, piecewise constant (a tetrahedron
+  /// takes the modulus of the slab holding its centroid), instead of interpolated by MaterialMap.
+  bool slabs = false;
   double rayleigh_alpha = 2.0e-2;  ///< 1/s
   double rayleigh_beta = 1.0e-3;   ///< s
 
