@@ -49,9 +49,9 @@ struct MaterialMapCandidate {
   int control_points = 0;
   int parameters = 0;  ///< fitted unknowns
   int residual_count = 0;
-  double residual_rms_m = 0;  ///< per coordinate
+  double residual_rms_m = 0;    ///< per coordinate
   double lag1_correlation = 0;  ///< of its residual series over frames (pooled)
-  double bic = 0;  ///< with the design effect of the best-fitting candidate (see above)
+  double bic = 0;               ///< with the design effect of the best-fitting candidate (see above)
   bool converged = false;
   double cpu_time_s = 0;
 };
