@@ -95,6 +95,13 @@ class Samples(unittest.TestCase):
                 with open(os.path.join(out, "particles.csv")) as f:
                     times = {row["t"] for row in csv.DictReader(f)}
                 self.assertEqual(len(times), n)
+                # the plan's mesh and wrench went through pliant's recording reader and writer
+                self.assertEqual(chk.read_vtk(os.path.join(out, "mesh.vtk"))[0].shape,
+                                 chk.read_vtk(os.path.join(d, "mesh.vtk"))[0].shape)
+                if os.path.exists(os.path.join(d, "wrench.csv")):
+                    w_in = np.loadtxt(os.path.join(d, "wrench.csv"), delimiter=",", skiprows=1)
+                    w_out = np.loadtxt(os.path.join(out, "wrench.csv"), delimiter=",", skiprows=1)
+                    np.testing.assert_allclose(w_out, w_in, rtol=1e-5, atol=1e-9)
 
     def test_frame0_lies_on_the_mesh_surface_within_the_noise(self):
         for case in CASES:
@@ -154,7 +161,6 @@ class Samples(unittest.TestCase):
                   f"peak {np.abs(fk[:, 2]).max():.2f} N")
             self.assertLess(abs(r.std() / sd - 1), 0.15, case)
             self.assertLess(np.abs(r.mean(axis=0)).max(), 4 * sd / np.sqrt(len(t)), case)
-            self.assertLess(np.percentile(np.abs(fk[:, 2]), 100), 1e3)
             self.assertGreater(np.abs(fk[:, 2]).max(), 20 * sd, case)
 
 
@@ -188,8 +194,11 @@ class Generator(unittest.TestCase):
         print(f"renderer: plane exact to {np.abs(z[ident == -1] - zp[ident == -1]).max():.1e} m; sphere within "
               f"{1e6 * err.max():.1f} um of the closed form along the normal (facet sagitta {1e6 * sagitta:.1f} um)")
         self.assertLess(err.max(), 1.5 * sagitta)
-        # nothing is drawn outside the sphere's silhouette but the plane
-        self.assertTrue(np.all(ident[~np.isfinite(zs) & (ident >= 0)] < 0) or not np.any(~np.isfinite(zs) & (ident >= 0)))
+        # the facets are inscribed: every pixel drawn as sphere has a ray that meets the true sphere,
+        # and every ray through the sphere's middle (the inscribed polyhedron's) is drawn as sphere
+        self.assertFalse(np.any((ident >= 0) & (disc < 0)))
+        inner = disc > 0.2 * np.max(disc)
+        self.assertTrue(np.all(ident[inner] >= 0))
 
     def test_calculix_against_uniaxial_compression(self):
         with open(os.path.join(SAMPLES, "validation.json")) as f:

@@ -63,7 +63,7 @@ def quaternion(R):
     return q if q[3] >= 0 else -q
 
 
-def _candidates(cam, tri, first_id, size):
+def _candidates(cam, tri, size):
     """Pixels covered by triangles (k, 3, 3) in camera coordinates, all with screen boxes of at
     most size x size: pixel index, depth and triangle id of each covered pixel."""
     z = tri[:, :, 2]
@@ -90,7 +90,7 @@ def _candidates(cam, tri, first_id, size):
     ok = keep & (np.abs(den) > 1e-12 * np.linalg.norm(n, axis=1)[:, None])
     depth = np.where(ok, num / np.where(ok, den, 1.0), np.inf)
     ok &= depth > 0
-    ids = np.broadcast_to(first_id + np.arange(len(tri))[:, None], pu.shape)
+    ids = np.broadcast_to(np.arange(len(tri))[:, None], pu.shape)
     return (pv * cam.width + pu)[ok], depth[ok], ids[ok]
 
 
@@ -117,7 +117,7 @@ def render(cam, triangles, plane=None, near=0.05):
             chunk = max(1, 2_000_000 // (size * size))
             for s in range(0, len(sel), chunk):
                 part = sel[s:s + chunk]
-                i, d, k = _candidates(cam, t[part], 0, size)
+                i, d, k = _candidates(cam, t[part], size)
                 idx_parts.append(i)
                 z_parts.append(d)
                 id_parts.append(ids_all[part][k])
