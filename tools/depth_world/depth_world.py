@@ -124,7 +124,7 @@ def crop_box(frames, margin=24):
     return int(u0), int(v0), int(u1 - u0), int(v1 - v0)
 
 
-def write_plan(outdir, spec, res, fixed, driven, travel_axis):
+def write_plan(outdir, spec, res, fixed, driven, travel_axis, camera_text):
     pts, tets = res["coarse_points"], res["coarse_tets"]
     mesh.write_vtk(os.path.join(outdir, "mesh.vtk"), pts, tets)
     mat = spec["material"]
@@ -142,7 +142,8 @@ def write_plan(outdir, spec, res, fixed, driven, travel_axis):
                       "fixed": [int(i) for i in fixed], "driven": [int(i) for i in driven]},
         "files": files,
         "material": {"poisson_ratio": mat["poisson_ratio"], "density": mat["density"]},
-        "meta": {"object": what, "source": "simulated (tools/depth_world/depth_world.py, CalculiX)"},
+        "meta": {"object": what, "source": "simulated (tools/depth_world/depth_world.py, CalculiX)",
+                 "camera": camera_text},
     }
     if spec["kind"] == "indentation":
         files["wrench"] = "wrench.csv"
@@ -198,8 +199,12 @@ def make_case(spec, outdir, cache_dir):
     axis = scene.tool_axis(spec["tool"]) if spec["kind"] == "indentation" else np.zeros(3)
     driven = (scene.in_footprint(pts, spec["shape"], spec["tool"]["footprint"]) if spec["kind"] == "indentation"
               else np.array([], dtype=np.int64))
-    write_plan(outdir, spec, res, fixed, driven, axis)
     pose = list(cam.t) + list(render.quaternion(cam.R))
+    text = ("Kinect-class depth camera, 640 x 480%s, %.0f frames/s; its pose in this recording's frame "
+            "(x = R(q) x_camera + t) is camera_pose.txt: --camera-pose %s" % (
+                "" if (w, h) == (640, 480) else " cropped to %d x %d at (%d, %d)" % (w, h, u0, v0),
+                spec["frame_rate_hz"], ",".join("%.9g" % v for v in pose)))
+    write_plan(outdir, spec, res, fixed, driven, axis, text)
     with open(os.path.join(outdir, "camera_pose.txt"), "w") as f:
         f.write(",".join("%.9g" % v for v in pose) + "\n")
 
