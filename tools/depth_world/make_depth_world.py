@@ -117,8 +117,9 @@ def family(seed, n):
                 # St. Venant-Kirchhoff collapses in strong compression: deep presses are neo-Hookean
                 "material": {"law": law if depth_fraction < 0.15 else "neo_hooke", "youngs_modulus": e,
                              "poisson_ratio": nu, "density": rho},
-                "protocol": {"still": 0.3, "press": float(np.round(r.uniform(0.4, 0.7), 2)), "hold": 0.2,
-                             "release": float(np.round(r.uniform(0.4, 0.7), 2)), "end_hold": 0.1,
+                # whole frames (30 Hz) in every phase, so that the solved increments are the frames
+                "protocol": {"still": 0.3, "press": int(r.integers(12, 22)) / 30, "hold": 0.2,
+                             "release": int(r.integers(12, 22)) / 30, "end_hold": 0.1,
                              "depth": float(np.round(depth_fraction * h, 5)), "release_fraction": 1.0},
                 "camera": cam, "sensor": sensor(r),
                 "wrench": {"rate_hz": float(r.choice([100, 125, 200, 250, 500])), "phase": float(np.round(r.random(), 3)),

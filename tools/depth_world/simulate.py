@@ -25,6 +25,16 @@ def _meshes(spec, footprint):
     return p4, t4, fine, t10, coarse, ct4
 
 
+def at_frames(times, n, dt, what):
+    """Indices of the blocks solved at the frames dt, 2 dt, ..., n dt (ccx may add a sliver of an
+    increment when the end time is not a whole number of increments in floating point)."""
+    times = np.asarray(times)
+    idx = np.array([int(np.argmin(np.abs(times - k * dt))) for k in range(1, n + 1)], dtype=np.int64)
+    if len(times) == 0 or np.max(np.abs(times[idx] - dt * np.arange(1, n + 1))) > 0.01 * dt:
+        raise RuntimeError(f"{what}: no solution at every frame ({len(times)} blocks for {n} frames)")
+    return idx
+
+
 def solve(spec, workdir):
     kind = spec["kind"]
     footprint = spec["tool"]["footprint"] if kind == "indentation" else None
@@ -42,8 +52,8 @@ def solve(spec, workdir):
         t_f, node_ids, per_node, totals = ccx.read_dat_forces(os.path.join(workdir, "job.dat"), len(driven))
         t_u, ids, u = ccx.read_frd_displacements(os.path.join(workdir, "job.frd"))
         n = int(round(table[2] / dt))
-        if len(t_u) != n or len(t_f) != n:
-            raise RuntimeError(f"{workdir}: {len(t_u)} frames / {len(t_f)} force samples, expected {n}")
+        iu, i_f = at_frames(t_u, n, dt, workdir), at_frames(t_f, n, dt, workdir)
+        t_u, u, t_f, per_node, totals = t_u[iu], u[iu], t_f[i_f], per_node[i_f], totals[i_f]
         frame_t = np.concatenate([[0.0], t_u])
         full = np.zeros((n + 1, len(fine), 3))
         full[1:, ids, :] = u  # frame 0: the tool has not moved, nothing is loaded
@@ -63,10 +73,12 @@ def solve(spec, workdir):
         inc = scene.run_deck(workdir, scene.free_motion_deck, run)
         t_u, ids, u = ccx.read_frd_displacements(os.path.join(workdir, "job.frd"))
         n = int(round(spec["duration_s"] / dt))
-        if len(t_u) < n + 1:
-            raise RuntimeError(f"{workdir}: {len(t_u)} displacement blocks, expected at least {n + 1}")
+        # the static step's blocks come first and end at time 1; the dynamic step's follow (ccx
+        # writes the total time: 1 + t)
+        last_static = int(np.nonzero(np.abs(t_u - 1.0) < 1e-9)[0][0])
+        dyn = last_static + 1 + at_frames(t_u[last_static + 1:] - 1.0, n, dt, workdir)
         full = np.zeros((n + 1, len(fine), 3))
-        full[:, ids, :] = u[-(n + 1):]  # the static step's last state, then the n dynamic frames
+        full[:, ids, :] = u[np.concatenate([[last_static], dyn])]  # the bent state, then the frames
         frame_t = np.arange(n + 1) * dt
     elems, weights = interp.locate(fine, t10, coarse)
     out.update({
