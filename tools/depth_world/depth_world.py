@@ -254,10 +254,20 @@ def make_case(spec, outdir, cache_dir):
                          "driven_particles": [int(i) for i in driven]}
     else:
         truth["parameters"].update(rayleigh_alpha=spec["rayleigh_alpha"], rayleigh_beta=spec["rayleigh_beta"])
-    with open(os.path.join(outdir, "truth.json"), "w") as f:
-        json.dump(truth, f, indent=1, sort_keys=True)
-        f.write("\n")
+    write_truth(os.path.join(outdir, "truth.json"), truth)
     return truth
+
+
+def write_truth(path, truth):
+    """JSON with the per-frame arrays one frame to a line (the file stays readable and small)."""
+    per_frame = ("displacement_m", "contact_force_n", "contact_torque_nm", "mask_counts_per_frame")
+    text = json.dumps({k: ("@" + k if k in per_frame else v) for k, v in truth.items()}, indent=1, sort_keys=True)
+    for k in per_frame:
+        if k in truth:
+            rows = ",\n  ".join(json.dumps(row, separators=(",", ":"), sort_keys=True) for row in truth[k])
+            text = text.replace(json.dumps("@" + k), "[\n  " + rows + "\n ]")
+    with open(path, "w") as f:
+        f.write(text + "\n")
 
 
 def main():
