@@ -14,7 +14,8 @@ committed files (no CalculiX needed).
   free-motion sample's vibration against beam theory (frequency) and the Rayleigh damping it was
   given (decay).
 
-Run: /usr/bin/python3 tests/depth_world/test_depth_world.py (ctest depth_world_samples).
+Run: /usr/bin/python3 tests/depth_world/test_depth_world.py (ctest depth_world_samples); with
+DEPTH_WORLD_DIR=DIR (and PLIANT_EXE), the same checks on a family make_depth_world.py wrote.
 """
 import csv
 import json
@@ -28,7 +29,8 @@ import unittest
 import numpy as np
 
 ROOT = os.environ.get("PLIANT_SOURCE_DIR", os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
-SAMPLES = os.path.join(ROOT, "examples", "depth_world")
+# DEPTH_WORLD_DIR: run the same checks on a generated family instead of the committed samples
+SAMPLES = os.environ.get("DEPTH_WORLD_DIR", os.path.join(ROOT, "examples", "depth_world"))
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "tools", "depth_world"))
 import depth_world_checks as chk  # noqa: E402
@@ -71,6 +73,8 @@ def labelled(case, truth, k, edge_px=3):
 
 class Samples(unittest.TestCase):
     def test_three_samples(self):
+        if "DEPTH_WORLD_DIR" in os.environ:
+            self.skipTest("a generated family")
         kinds = [truth_of(c)["kind"] for c in CASES]
         self.assertEqual(kinds.count("indentation"), 2)
         self.assertEqual(kinds.count("free_motion"), 1)
@@ -113,12 +117,15 @@ class Samples(unittest.TestCase):
                 self.assertGreater(m.sum(), 150, f"{case} {name}")
                 r = z[m] - pred[m]
                 s = sigma[m]
+                # in units of each pixel's stated sd (a few pixels seen almost edge-on, where the
+                # stated sd explodes, would otherwise dominate an rms in millimetres)
+                zrms = np.sqrt(np.mean((r / s) ** 2))
                 rms, expected = np.sqrt(np.mean(r ** 2)), np.sqrt(np.mean(s ** 2))
                 print(f"{case}: frame 0 {name}: {m.sum()} px, rms {1e3 * rms:.3f} mm against {1e3 * expected:.3f} mm "
-                      f"stated, bias {1e3 * r.mean():.3f} mm, p99.9 {np.percentile(np.abs(r / s), 99.9):.2f} sd")
-                self.assertLess(abs(r.mean()), 0.25 * expected, f"{case} {name} bias")
-                self.assertLess(rms, 1.2 * expected, f"{case} {name} rms")
-                self.assertGreater(rms, 0.8 * expected, f"{case} {name} rms")
+                      f"stated ({zrms:.3f} sd), bias {np.mean(r / s):.3f} sd, p99.9 {np.percentile(np.abs(r / s), 99.9):.2f} sd")
+                self.assertLess(abs(np.mean(r / s)), 0.25, f"{case} {name} bias")
+                self.assertLess(zrms, 1.2, f"{case} {name} rms")
+                self.assertGreater(zrms, 0.8, f"{case} {name} rms")
                 self.assertLess(np.percentile(np.abs(r / s), 99.9), 4.5, f"{case} {name} tail")
 
     def test_deformed_frames_lie_on_the_moved_mesh_within_the_noise(self):
@@ -135,13 +142,15 @@ class Samples(unittest.TestCase):
             z, pred, lab, sigma, interior, _ = labelled(case, truth, k)
             m = interior & (lab == 1)
             r = z[m] - pred[m]
+            rn = r / sigma[m]
             rms, expected = np.sqrt(np.mean(r ** 2)), np.sqrt(np.mean(sigma[m] ** 2))
             print(f"{case}: frame {k} object: {m.sum()} px, rms {1e3 * rms:.3f} mm against {1e3 * expected:.3f} mm "
-                  f"stated, bias {1e3 * r.mean():.3f} mm, p99.9 {np.percentile(np.abs(r / sigma[m]), 99.9):.2f} sd")
+                  f"stated ({np.sqrt(np.mean(rn ** 2)):.3f} sd), bias {np.mean(rn):.3f} sd, "
+                  f"p99.9 {np.percentile(np.abs(rn), 99.9):.2f} sd")
             self.assertGreater(m.sum(), 150, case)
-            self.assertLess(abs(r.mean()), 0.3 * expected, case)
-            self.assertLess(rms, 1.25 * expected, case)
-            self.assertLess(np.percentile(np.abs(r / sigma[m]), 99.9), 5, case)
+            self.assertLess(abs(np.mean(rn)), 0.3, case)
+            self.assertLess(np.sqrt(np.mean(rn ** 2)), 1.25, case)
+            self.assertLess(np.percentile(np.abs(rn), 99.9), 5, case)
 
     def test_probe_is_nearer_where_it_hides_the_object(self):
         for case in CASES:
@@ -149,18 +158,18 @@ class Samples(unittest.TestCase):
             if truth["kind"] != "indentation":
                 continue
             k = int(np.argmax(truth["tool"]["travel_m"]))
-            z, pred, lab, sigma, interior, depths = labelled(case, truth, k, edge_px=1)
+            z, pred, lab, sigma, interior, depths = labelled(case, truth, k, edge_px=2)
             # pixels where the probe is clearly (4 sd) in front of the object
             with np.errstate(invalid="ignore"):
                 hides = interior & (lab == 2) & np.isfinite(depths[1]) & (depths[1] - depths[2] > 4 * sigma)
-            self.assertGreater(hides.sum(), 20, case)
+            self.assertGreater(hides.sum(), 30, case)
             self.assertTrue(np.all(depths[2][hides] < depths[1][hides]))
             near_probe = np.abs(z[hides] - depths[2][hides]) < 4 * sigma[hides]
             behind = z[hides] < depths[1][hides] - 2 * sigma[hides]
             print(f"{case}: frame {k}: probe over the object at {hides.sum()} px, "
                   f"{100 * near_probe.mean():.1f} % within 4 sd of the probe, {100 * behind.mean():.1f} % nearer than the object")
-            self.assertGreater(near_probe.mean(), 0.97, case)
-            self.assertGreater(behind.mean(), 0.97, case)
+            self.assertGreater(near_probe.mean(), 0.95, case)
+            self.assertGreater(behind.mean(), 0.95, case)
 
     def test_wrench_agrees_with_the_contact_force(self):
         for case in CASES:
@@ -224,6 +233,8 @@ class Generator(unittest.TestCase):
         self.assertTrue(np.all(ident[inner] >= 0))
 
     def test_calculix_against_uniaxial_compression(self):
+        if not os.path.exists(os.path.join(SAMPLES, "validation.json")) and "DEPTH_WORLD_DIR" in os.environ:
+            self.skipTest("no validation.json in a generated family")
         with open(os.path.join(SAMPLES, "validation.json")) as f:
             v = json.load(f)
         reference = v["youngs_modulus"] * v["side_m"] ** 2 * v["strain"]
