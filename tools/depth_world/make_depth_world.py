@@ -104,9 +104,14 @@ def family(seed, n):
                 half = shape["radius"] / 1.5
                 h = shape["height"]
             size = float(np.round(r.uniform(0.3, 0.45) * half, 4))
-            fp = ({"kind": "round", "radius": size} if r.random() < 0.5 else {"kind": "square", "side": 2 * size})
+            # round and square probes alternate, and every other pair of indentations is tilted
+            # by 5-25 deg (the draws are made either way, so the other parameters do not move)
+            j = k - k // 3
+            r.random()
+            fp = {"kind": "round", "radius": size} if j % 2 == 0 else {"kind": "square", "side": 2 * size}
             fp["center"] = [float(np.round(v, 4)) for v in r.uniform(-0.25, 0.25, 2) * half]
-            tilt = float(np.round(r.uniform(0, 25), 1)) if r.random() < 0.5 else 0.0
+            r.random()
+            tilt = float(np.round(5 + 20 * r.random(), 1)) if j % 4 in (2, 3) else 0.0
             depth_fraction = r.uniform(0.10, 0.25)
             out.append({
                 "name": "case_%02d" % k, "kind": "indentation", "seed": case_seed, "shape": shape,
