@@ -180,7 +180,8 @@ def make_case(spec, outdir, cache_dir):
     cam = camera_of(spec)
     frames, proj, p = render_frames(spec, res, cam)
     u0, v0, w, h = crop_box(frames) if spec["camera"].get("crop") else (0, 0, 640, 480)
-    os.makedirs(os.path.join(outdir, "depth"), exist_ok=True)
+    shutil.rmtree(os.path.join(outdir, "depth"), ignore_errors=True)  # no frames left from an earlier run
+    os.makedirs(os.path.join(outdir, "depth"))
     rows, counts = [], []
     for k, (z, cosang, ident, zp, label) in enumerate(frames):
         raw, masks = sensor.apply(cam, z, cosang, ident, proj, zp, rng, p)
