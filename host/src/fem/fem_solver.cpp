@@ -453,6 +453,52 @@ void FemSolver::add_tangent_product(const Eigen::Ref<const Eigen::VectorXd>& pos
   out += im.sensitivity;
 }
 
+void FemSolver::add_tangent_products(const Eigen::Ref<const Eigen::VectorXd>& position_m,
+                                     const std::vector<const Eigen::VectorXd*>& u, const std::vector<double>& scales,
+                                     const std::vector<Eigen::VectorXd*>& out, double force_scale,
+                                     Eigen::VectorXd* force_out) {
+  const FemModel& model = *model_;
+  const Eigen::Index dofs = model.dof_count();
+  if (u.size() != scales.size() || u.size() != out.size() || position_m.size() != dofs) {
+    throw std::invalid_argument("FemSolver: tangent products need one scale and output per vector, 3n positions");
+  }
+  for (std::size_t k = 0; k < u.size(); ++k) {
+    if (u[k]->size() != dofs || out[k]->size() != dofs) {
+      throw std::invalid_argument("FemSolver: tangent product vectors must have 3n entries");
+    }
+  }
+  if (force_out != nullptr && force_out->size() != dofs) {
+    throw std::invalid_argument("FemSolver: internal force vectors must have 3n entries");
+  }
+  if (model.nodal_volumetric()) {  // the nodal pressure rate is per vector: one pass each
+    for (std::size_t k = 0; k < u.size(); ++k) add_tangent_product(position_m, *u[k], scales[k], *out[k]);
+    if (force_out != nullptr) add_internal_force(position_m, force_scale, *force_out);
+    return;
+  }
+  const double mu1 = model.unit_mu();
+  const double lambda1 = model.unit_element_lambda();
+  const double* xs = position_m.data();
+  for (int e = 0; e < model.element_count(); ++e) {
+    const auto& nodes = model.elements()[uz(e)];
+    const detail::Mat34& b = model.shape_gradients(e);
+    const Eigen::Matrix3d f = detail::gather_gradient(xs, nodes, b);
+    const Eigen::Matrix3d r = polar_rotation(f);
+    const double youngs = model.youngs_modulus_pa()[e];
+    const double mu = youngs * mu1;
+    const double lambda = youngs * lambda1;
+    const double volume = model.element_volume_m3()[e];
+    if (force_out != nullptr) {
+      const Eigen::Matrix3d p = detail::corotated_stress(f, r, mu, lambda, nullptr);
+      const detail::Mat34 corner = (-force_scale * volume) * (p * b);
+      for (int a = 0; a < 4; ++a) force_out->segment<3>(3 * nodes[uz(a)]) += corner.col(a);
+    }
+    const detail::Mat34 c = r * b;
+    for (std::size_t k = 0; k < u.size(); ++k) {
+      detail::add_rotated_stiffness_product(c, volume, mu, lambda, u[k]->data(), nodes, scales[k], out[k]->data());
+    }
+  }
+}
+
 void FemSolver::add_internal_force(const Eigen::Ref<const Eigen::VectorXd>& position_m, double scale,
                                    Eigen::Ref<Eigen::VectorXd> out) {
   Impl& im = *impl_;

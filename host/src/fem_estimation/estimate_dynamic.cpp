@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <deque>
 #include <functional>
@@ -572,7 +573,13 @@ class SensitivityEvaluator {
     std::future<SensitiveEvaluation> future;
   };
 
-  static bool same(const std::vector<double>& a, const std::vector<double>& b) { return a == b; }
+  // Equal to 1e-12 relative: the optimiser's exp(log x) and the caller's x differ in the last bit.
+  static bool same(const std::vector<double>& a, const std::vector<double>& b) {
+    for (std::size_t j = 0; j < a.size(); ++j) {
+      if (std::abs(a[j] - b[j]) > 1e-12 * std::max(std::abs(a[j]), std::abs(b[j]))) return false;
+    }
+    return true;
+  }
 
   const SensitiveEvaluation* find_done(const std::vector<double>& values, bool need_jacobian) const {
     for (const SensitiveEvaluation& e : done_) {
@@ -607,6 +614,9 @@ class SensitivityEvaluator {
   }
 
   void launch(const std::vector<double>& values, bool with_jacobian, int slot) {
+    if (std::getenv("PLIANT_DEBUG_SENS"))
+      std::fprintf(stderr, "launch %s %.8g %.8g slot %d\n", with_jacobian ? "J" : "R", values[0],
+                   values.size() > 1 ? values[1] : 0.0, slot);
     busy_[uz(slot)] = true;
     ++simulations_;
     Simulator* simulator = simulators_[uz(slot)].get();
@@ -715,29 +725,6 @@ std::string sensitivities_unavailable(const TrajectoryEstimateOptions& options, 
   if (options.simulation.initial_velocity != InitialVelocity::at_rest) return "initial velocity from the data";
   if (layout.use_wrench) return "measured wrench applied as a load";
   return "";
-}
-
-// Standard deviations as FitResult has them (Gauss-Newton covariance scaled by the residual
-// scatter) from a Jacobian in log parameters taken next to the solution.
-void set_uncertainty(const Eigen::MatrixXd& jacobian_log, const std::vector<double>& residuals, FitResult& fit) {
-  const Eigen::Index n = jacobian_log.cols();
-  const double m = static_cast<double>(residuals.size());
-  double sum = 0;
-  for (double r : residuals) sum += r * r;
-  fit.residual_sigma = m > static_cast<double>(n) ? std::sqrt(sum / (m - static_cast<double>(n))) : kNaN;
-  const Eigen::MatrixXd normal = jacobian_log.transpose() * jacobian_log;
-  const Eigen::FullPivLU<Eigen::MatrixXd> lu(normal);
-  fit.covariance = Eigen::MatrixXd::Constant(n, n, kNaN);
-  fit.standard_deviations.assign(static_cast<std::size_t>(n), kNaN);
-  if (lu.rank() < n) return;
-  const Eigen::MatrixXd inverse = lu.inverse() * (fit.residual_sigma * fit.residual_sigma);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    for (Eigen::Index j = 0; j < n; ++j) {
-      fit.covariance(i, j) =
-          inverse(i, j) * fit.values[static_cast<std::size_t>(i)] * fit.values[static_cast<std::size_t>(j)];
-    }
-    fit.standard_deviations[static_cast<std::size_t>(i)] = std::sqrt(fit.covariance(i, i));
-  }
 }
 
 double rms(const std::vector<double>& r, double scale) {
@@ -976,7 +963,6 @@ TrajectoryEstimate estimate_trajectory_parameters(const FemRecordingProblem& pro
     windows.clear();
     fit_options.max_iterations = 1;
     fit_options.projected_line_search = false;
-    if (use_sensitivities) fit_options.uncertainty = false;  // from the start's Jacobian below
     char line[200];
     std::snprintf(line, sizeof line,
                   "the warm start explains the data within the noise (chi-square per degree of freedom %.3g <= "
@@ -1011,12 +997,6 @@ TrajectoryEstimate estimate_trajectory_parameters(const FemRecordingProblem& pro
   result.residual_rms_m = rms(final_residuals, options.position_noise_m);
   if (result.stopped_at_start) {
     result.fit.converged = true;  // by the noise test, not by a tolerance
-    if (use_sensitivities) {
-      std::vector<double> ignored;
-      Eigen::MatrixXd jacobian;
-      evaluator->sensitive->jacobian(result.start_values, ignored, jacobian);
-      set_uncertainty(jacobian, final_residuals, result.fit);
-    }
     result.fit.message = result.stop_reason + "; " + result.fit.message;
   }
   result.simulations += evaluator->simulations();

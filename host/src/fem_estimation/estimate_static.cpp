@@ -332,7 +332,8 @@ class FramePool {
         return e.converged;
       }
     }
-    if (scale_by_modulus_ && driven_position == nullptr && load.size() == 0 && reuse_scaled(c, youngs_modulus_pa, key)) {
+    if (scale_by_modulus_ && driven_position == nullptr && load.size() == 0 &&
+        reuse_scaled(c, youngs_modulus_pa, key)) {
       return true;
     }
     w.model->set_youngs_modulus(youngs_modulus_pa);  // O(elements), negligible beside a solve

@@ -59,40 +59,53 @@ void TrajectorySensitivity::substep(FemSolver& dynamic, const Eigen::VectorXd& s
   // The damping argument of the step (driven nodes with the secant velocity).
   w_ = c_d * (end_m - start_m) - c_dv * velocity_before_m_s;
   for (int node : dynamic.driven_nodes()) w_.segment<3>(3 * node) = (c_f / h) * (end_m - start_m).segment<3>(3 * node);
-  bool have_force = false;
-  for (std::size_t j = 0; j < parameters_.size(); ++j) {
+  // Right-hand sides without the stiffness terms, and the vectors K multiplies (one fused pass).
+  const std::size_t p = parameters_.size();
+  rhs_.resize(p);
+  product_.resize(p);
+  bool need_force = false;
+  for (std::size_t j = 0; j < p; ++j) {
+    const Eigen::VectorXd& s = position_[j];
+    const Eigen::VectorXd& sv = velocity_[j];
+    const Eigen::VectorXd& sa = acceleration_[j];
+    mass_times(model, (1.0 + alpha * c_d) * s + (h + alpha * c_dv) * sv + c_a * sa, rhs_[j]);
+    product_[j] = c_d * s + c_dv * sv;  // beta K of this enters every right-hand side
+    switch (parameters_[j]) {
+      case SensitivityParameter::log_youngs_modulus:  // - dR/dlogE = c_f f_int(x+) - beta K w
+        need_force = true;
+        product_[j] -= w_;
+        break;
+      case SensitivityParameter::log_rayleigh_alpha:  // - dR/dlog alpha = -alpha M w
+        mass_times(model, w_, kw_);
+        rhs_[j] -= alpha * kw_;
+        break;
+      case SensitivityParameter::log_rayleigh_beta:  // - dR/dlog beta = -beta K w
+        product_[j] -= w_;
+        break;
+    }
+  }
+  std::vector<const Eigen::VectorXd*> vectors;
+  std::vector<double> scales;
+  std::vector<Eigen::VectorXd*> outputs;
+  if (beta > 0) {
+    for (std::size_t j = 0; j < p; ++j) {
+      vectors.push_back(&product_[j]);
+      scales.push_back(beta);
+      outputs.push_back(&rhs_[j]);
+    }
+  }
+  if (need_force) force_.setZero(model.dof_count());
+  dynamic.add_tangent_products(end_m, vectors, scales, outputs, c_f, need_force ? &force_ : nullptr);
+  for (std::size_t j = 0; j < p; ++j) {
+    if (parameters_[j] == SensitivityParameter::log_youngs_modulus) rhs_[j] += force_;
+    dynamic.solve_last_factorized(rhs_[j]);  // S+ (zero at constrained nodes)
     Eigen::VectorXd& s = position_[j];
     Eigen::VectorXd& sv = velocity_[j];
     Eigen::VectorXd& sa = acceleration_[j];
-    u_ = c_d * s + c_dv * sv;
-    mass_times(model, (1.0 + alpha * c_d) * s + (h + alpha * c_dv) * sv + c_a * sa, rhs_);
-    switch (parameters_[j]) {
-      case SensitivityParameter::log_youngs_modulus:
-        // - dR/dlogE = c_f f_int(x+) - beta K w.
-        if (!have_force) {
-          force_.setZero(model.dof_count());
-          dynamic.add_internal_force(end_m, 1.0, force_);
-          have_force = true;
-        }
-        rhs_ += c_f * force_;
-        if (beta > 0) dynamic.add_tangent_product(end_m, u_ - w_, beta, rhs_);
-        break;
-      case SensitivityParameter::log_rayleigh_alpha:
-        // - dR/dlog alpha = -alpha M w.
-        mass_times(model, w_, kw_);
-        rhs_ -= alpha * kw_;
-        if (beta > 0) dynamic.add_tangent_product(end_m, u_, beta, rhs_);
-        break;
-      case SensitivityParameter::log_rayleigh_beta:
-        // - dR/dlog beta = -beta K w.
-        if (beta > 0) dynamic.add_tangent_product(end_m, u_ - w_, beta, rhs_);
-        break;
-    }
-    dynamic.solve_last_factorized(rhs_);  // S+ (zero at constrained nodes)
-    const Eigen::VectorXd change = rhs_ - s;
-    sa = (4.0 / (h * h)) * (change - h * sv) - sa;
-    sv = (2.0 / h) * change - sv;
-    s = rhs_;
+    change_ = rhs_[j] - s;
+    sa = (4.0 / (h * h)) * (change_ - h * sv) - sa;
+    sv = (2.0 / h) * change_ - sv;
+    s = rhs_[j];
   }
 }
 

@@ -25,8 +25,9 @@
 // M S_a = f_int - K S for log E. A wrench applied as a load, initial velocities from the data,
 // backward Euler and material maps are not covered (the estimator uses finite differences).
 //
-// Cost per substep: one element pass per parameter (plus one for log E) and one back
-// substitution per parameter. Not thread-safe: one per simulator.
+// Cost per substep: one element pass (every parameter's stiffness product and the internal force
+// together; one per parameter under the averaged nodal pressure) and one back substitution per
+// parameter. Not thread-safe: one per simulator.
 #pragma once
 
 #include <vector>
@@ -62,7 +63,8 @@ class TrajectorySensitivity {
  private:
   std::vector<SensitivityParameter> parameters_;
   std::vector<Eigen::VectorXd> position_, velocity_, acceleration_;
-  Eigen::VectorXd w_, kw_, force_, rhs_, u_;
+  std::vector<Eigen::VectorXd> rhs_, product_;
+  Eigen::VectorXd w_, kw_, force_, change_;
 };
 
 }  // namespace pliant::host::fem::detail

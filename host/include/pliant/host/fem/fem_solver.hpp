@@ -192,6 +192,14 @@ class FemSolver {
   void add_tangent_product(const Eigen::Ref<const Eigen::VectorXd>& position_m,
                            const Eigen::Ref<const Eigen::VectorXd>& u, double scale, Eigen::Ref<Eigen::VectorXd> out);
 
+  /// Several products at once, out[k] += scales[k] * K(position_m) u[k], and, when force_out is
+  /// not null, force_out += force_scale * f_int(position_m): one pass over the elements (each
+  /// rotation computed once) under the element formulation; one pass per product under the
+  /// averaged nodal pressure. Sizes as above; u, scales and out of equal length.
+  void add_tangent_products(const Eigen::Ref<const Eigen::VectorXd>& position_m,
+                            const std::vector<const Eigen::VectorXd*>& u, const std::vector<double>& scales,
+                            const std::vector<Eigen::VectorXd*>& out, double force_scale, Eigen::VectorXd* force_out);
+
   /// out += scale * f_int(position_m) (3n, N): the elastic forces on the nodes. One element pass.
   void add_internal_force(const Eigen::Ref<const Eigen::VectorXd>& position_m, double scale,
                           Eigen::Ref<Eigen::VectorXd> out);
