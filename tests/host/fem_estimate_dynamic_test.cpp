@@ -402,7 +402,7 @@ TEST_F(FemEstimateDynamic, ForwardSensitivitiesMatchFiniteDifferencesOfTheSimula
       }
       const double relative = std::sqrt(difference / norm);
       std::printf("off %.1f parameter %d: relative difference %.3g\n", off, j, relative);
-      EXPECT_LT(relative, 2e-2) << "parameter " << j << " off " << off;
+      EXPECT_LT(relative, 5e-3) << "parameter " << j << " off " << off;
     }
   }
 }

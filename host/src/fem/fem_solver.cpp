@@ -456,7 +456,7 @@ void FemSolver::add_tangent_product(const Eigen::Ref<const Eigen::VectorXd>& pos
 void FemSolver::add_tangent_products(const Eigen::Ref<const Eigen::VectorXd>& position_m,
                                      const std::vector<const Eigen::VectorXd*>& u, const std::vector<double>& scales,
                                      const std::vector<Eigen::VectorXd*>& out, double force_scale,
-                                     Eigen::VectorXd* force_out) {
+                                     Eigen::VectorXd* force_out, bool rotation_derivative) {
   const FemModel& model = *model_;
   const Eigen::Index dofs = model.dof_count();
   if (u.size() != scales.size() || u.size() != out.size() || position_m.size() != dofs) {
@@ -491,6 +491,13 @@ void FemSolver::add_tangent_products(const Eigen::Ref<const Eigen::VectorXd>& po
       const Eigen::Matrix3d p = detail::corotated_stress(f, r, mu, lambda, nullptr);
       const detail::Mat34 corner = (-force_scale * volume) * (p * b);
       for (int a = 0; a < 4; ++a) force_out->segment<3>(3 * nodes[uz(a)]) += corner.col(a);
+    }
+    if (rotation_derivative) {
+      for (std::size_t k = 0; k < u.size(); ++k) {
+        detail::add_exact_stiffness_product(f, r, b, volume, mu, lambda, u[k]->data(), nodes, scales[k],
+                                            out[k]->data());
+      }
+      continue;
     }
     const detail::Mat34 c = r * b;
     for (std::size_t k = 0; k < u.size(); ++k) {

@@ -8,7 +8,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <ctime>
 #include <deque>
 #include <functional>
@@ -614,9 +613,6 @@ class SensitivityEvaluator {
   }
 
   void launch(const std::vector<double>& values, bool with_jacobian, int slot) {
-    if (std::getenv("PLIANT_DEBUG_SENS"))
-      std::fprintf(stderr, "launch %s %.8g %.8g slot %d\n", with_jacobian ? "J" : "R", values[0],
-                   values.size() > 1 ? values[1] : 0.0, slot);
     busy_[uz(slot)] = true;
     ++simulations_;
     Simulator* simulator = simulators_[uz(slot)].get();

@@ -63,6 +63,7 @@ void TrajectorySensitivity::substep(FemSolver& dynamic, const Eigen::VectorXd& s
   const std::size_t p = parameters_.size();
   rhs_.resize(p);
   product_.resize(p);
+  next_.resize(p);
   bool need_force = false;
   for (std::size_t j = 0; j < p; ++j) {
     const Eigen::VectorXd& s = position_[j];
@@ -98,14 +99,48 @@ void TrajectorySensitivity::substep(FemSolver& dynamic, const Eigen::VectorXd& s
   dynamic.add_tangent_products(end_m, vectors, scales, outputs, c_f, need_force ? &force_ : nullptr);
   for (std::size_t j = 0; j < p; ++j) {
     if (parameters_[j] == SensitivityParameter::log_youngs_modulus) rhs_[j] += force_;
-    dynamic.solve_last_factorized(rhs_[j]);  // S+ (zero at constrained nodes)
+    next_[j] = rhs_[j];
+    dynamic.solve_last_factorized(next_[j]);  // S+ with the step's matrix (zero at constrained nodes)
+  }
+  correct(dynamic, end_m, h);
+  for (std::size_t j = 0; j < p; ++j) {
     Eigen::VectorXd& s = position_[j];
     Eigen::VectorXd& sv = velocity_[j];
     Eigen::VectorXd& sa = acceleration_[j];
-    change_ = rhs_[j] - s;
+    change_ = next_[j] - s;
     sa = (4.0 / (h * h)) * (change_ - h * sv) - sa;
     sv = (2.0 / h) * change_ - sv;
-    s = rhs_[j];
+    s = next_[j];
+  }
+}
+
+// One defect correction of S+ = A^-1 rhs: the step's matrix A drops the rotation derivative of
+// the elastic tangent (and is taken at the predicted positions); the implicit step's own
+// derivative is (1 + alpha c_d) M + c_f K_exact(x+) + beta c_d K(x+). S+ += A^-1 (rhs - that S+)
+// leaves an error of the square of A's relative error.
+void TrajectorySensitivity::correct(FemSolver& dynamic, const Eigen::VectorXd& end_m, double h) {
+  const FemModel& model = dynamic.model();
+  const double alpha = model.rayleigh_alpha();
+  const double beta = model.rayleigh_beta();
+  const double c_d = 0.5 * h;
+  const double c_f = 0.25 * h * h;
+  const std::size_t p = parameters_.size();
+  std::vector<const Eigen::VectorXd*> vectors;
+  std::vector<double> elastic, damping;
+  std::vector<Eigen::VectorXd*> outputs;
+  for (std::size_t j = 0; j < p; ++j) {
+    mass_times(model, next_[j], kw_);
+    rhs_[j] -= (1.0 + alpha * c_d) * kw_;
+    vectors.push_back(&next_[j]);
+    elastic.push_back(-c_f);
+    damping.push_back(-beta * c_d);
+    outputs.push_back(&rhs_[j]);
+  }
+  dynamic.add_tangent_products(end_m, vectors, elastic, outputs, 0.0, nullptr, true);
+  if (beta > 0) dynamic.add_tangent_products(end_m, vectors, damping, outputs, 0.0, nullptr, false);
+  for (std::size_t j = 0; j < p; ++j) {
+    dynamic.solve_last_factorized(rhs_[j]);
+    next_[j] += rhs_[j];
   }
 }
 

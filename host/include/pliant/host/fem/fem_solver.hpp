@@ -195,10 +195,13 @@ class FemSolver {
   /// Several products at once, out[k] += scales[k] * K(position_m) u[k], and, when force_out is
   /// not null, force_out += force_scale * f_int(position_m): one pass over the elements (each
   /// rotation computed once) under the element formulation; one pass per product under the
-  /// averaged nodal pressure. Sizes as above; u, scales and out of equal length.
+  /// averaged nodal pressure. Sizes as above; u, scales and out of equal length. With
+  /// `rotation_derivative` (element formulation only; ignored under the nodal pressure) K is the
+  /// exact tangent -d f_int / d x, the polar factor's derivative included.
   void add_tangent_products(const Eigen::Ref<const Eigen::VectorXd>& position_m,
                             const std::vector<const Eigen::VectorXd*>& u, const std::vector<double>& scales,
-                            const std::vector<Eigen::VectorXd*>& out, double force_scale, Eigen::VectorXd* force_out);
+                            const std::vector<Eigen::VectorXd*>& out, double force_scale, Eigen::VectorXd* force_out,
+                            bool rotation_derivative = false);
 
   /// out += scale * f_int(position_m) (3n, N): the elastic forces on the nodes. One element pass.
   void add_internal_force(const Eigen::Ref<const Eigen::VectorXd>& position_m, double scale,
