@@ -497,9 +497,9 @@ class LookAheadEvaluator {
 // ---------------------------------------------------------------------------------------------
 // Residual evaluation with exact Jacobians (forward sensitivities). fit_least_squares asks for the
 // residuals at a trial point and, once it accepts the point, for the Jacobian there. A Jacobian
-// run also yields the residuals, but costs more, so the trial point is simulated without
-// sensitivities and, on an idle thread, with them at the same time: when the point is accepted its
-// Jacobian is (nearly) ready; when it is rejected that run is cancelled at its next frame.
+// run also yields the residuals, so a trial point is simulated with its sensitivities at once:
+// steps are mostly accepted, and a plain run beside it (on the other core) would only cost CPU
+// time. A run at a point the optimiser has left is cancelled at its next frame.
 
 struct SensitiveEvaluation {
   std::vector<double> values;
@@ -526,7 +526,9 @@ class SensitivityEvaluator {
   SensitivityEvaluator(const SensitivityEvaluator&) = delete;
   SensitivityEvaluator& operator=(const SensitivityEvaluator&) = delete;
 
-  // Residuals at `values`; with `speculate` and an idle thread, the Jacobian there starts too.
+  // Residuals at `values`. With `speculate` (a trial point of the optimiser, usually accepted,
+  // and then its Jacobian is asked for next) the run carries the sensitivities: one run instead
+  // of a plain one followed by a Jacobian run.
   bool evaluate(const std::vector<double>& values, std::vector<double>& residuals, bool speculate = true) {
     reap();
     if (const SensitiveEvaluation* done = find_done(values, false)) {
@@ -534,13 +536,9 @@ class SensitivityEvaluator {
       return done->ok;
     }
     cancel_other(values);
-    if (find_job(values, true) == jobs_.end() || free_slot() >= 0) {
-      if (find_job(values, false) == jobs_.end()) launch(values, false, acquire_slot());
+    if (find_job(values, true) == jobs_.end() && find_job(values, false) == jobs_.end()) {
+      launch(values, speculate, acquire_slot());
     }
-    if (speculate && find_job(values, true) == jobs_.end() && find_done(values, true) == nullptr && free_slot() >= 0) {
-      launch(values, true, free_slot());
-    }
-    // The first run at `values` to finish answers (a Jacobian run has the same residuals).
     while (find_done(values, false) == nullptr) wait_any_at(values);
     const SensitiveEvaluation* done = find_done(values, false);
     residuals = done->residuals;

@@ -81,9 +81,11 @@
 // fitted as before. With position_noise_m too large for the data this stops early; it is the
 // noise the caller declares.
 //
-// Parallelism: fit_least_squares evaluates sequentially. With sensitivities, a trial point is
-// simulated without them while another thread simulates it with them (ready when the optimiser
-// accepts the point; cancelled at its next frame when it rejects it). With finite differences,
+// Parallelism: fit_least_squares evaluates sequentially. With sensitivities, each trial point is
+// one simulation with its sensitivities (the Jacobian the optimiser asks for once it accepts the
+// point); a second, plain simulation of it on the other core would answer a little sooner but
+// cost CPU time on every accepted step, so there is no parallel work left and `threads` only
+// matters with finite differences. There,
 // the residual function keeps a cache of recent simulations and, while the optimiser waits for one, runs on the other
 // threads the simulations the optimiser's finite differences will ask for next (the points
 // value * exp(+difference_step), and with central differences value * exp(-difference_step), of
