@@ -957,14 +957,14 @@ TrajectoryEstimate estimate_trajectory_parameters(const FemRecordingProblem& pro
     windows.clear();
     fit_options.max_iterations = 1;
     fit_options.projected_line_search = false;
-    char line[200];
+    char line[256];
     std::snprintf(line, sizeof line,
                   "the warm start explains the data within the noise (chi-square per degree of freedom %.3g <= "
                   "%.3g at position_noise_m %.3g m): one polishing step, no iterations",
                   result.start_chi_square_per_dof, result.explained_threshold, options.position_noise_m);
     result.stop_reason = line;
   } else if (options.stop_when_explained && warm_started) {
-    char line[200];
+    char line[256];
     std::snprintf(line, sizeof line,
                   "the warm start does not explain the data (chi-square per degree of freedom %.3g > %.3g): fitted",
                   result.start_chi_square_per_dof, result.explained_threshold);
