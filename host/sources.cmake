@@ -46,6 +46,7 @@ set(PLIANT_FEM_ESTIMATION_SOURCES
   ${pliant_host_src}/fem_estimation/estimate_static.cpp
   ${pliant_host_src}/fem_estimation/estimate_dynamic.cpp
   ${pliant_host_src}/fem_estimation/estimate_dynamic_modal.cpp
+  ${pliant_host_src}/fem_estimation/trajectory_sensitivity.cpp
   ${pliant_host_src}/fem_estimation/estimate_rest_shape.cpp
   ${pliant_host_src}/fem_estimation/material_map_selection.cpp)
 # importers of outside datasets: compression tests (fem/compression_test.hpp)

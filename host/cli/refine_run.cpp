@@ -230,6 +230,10 @@ void run_trajectory(const FemRecordingProblem& problem, const RefinePlan& plan, 
   d["simulations"] = e.simulations;
   d["substeps"] = s.substeps;
   d["start_rms"] = number(e.start_residual_rms_m * std::sqrt(3.0));
+  d["jacobian"] = e.jacobian;
+  d["start_chi_square_per_dof"] = number(e.start_chi_square_per_dof);
+  d["stopped_at_start"] = e.stopped_at_start;
+  d["stop_reason"] = e.stop_reason;
   d["warm_start"] = {{"modulus_matched", e.warm_start.modulus_matched},
                      {"damping_matched", e.warm_start.damping_matched},
                      {"youngs_modulus", e.warm_start.youngs_modulus_pa},

@@ -371,6 +371,99 @@ TEST_F(FemEstimateDynamic, RefusesUnusableProblemsAndOptions) {
   EXPECT_THROW(simulate_trajectory(good, Eigen::VectorXd::Constant(3, kE), kAlpha, kBeta), std::invalid_argument);
 }
 
+// The forward sensitivities the fit uses against central differences of the simulation itself
+// (the one-iteration linearised step, log steps of 1e-4), over every observed coordinate of every
+// frame, at the truth and at a point off in every parameter.
+TEST_F(FemEstimateDynamic, ForwardSensitivitiesMatchFiniteDifferencesOfTheSimulation) {
+  const FemRecordingProblem problem = fem_problem_from_recording(uniform_->recording);
+  TrajectorySimulationOptions options;
+  options.substeps = 4;
+  for (const double off : {1.0, 1.1}) {
+    const double e = kE * off, alpha = kAlpha * off * off, beta = kBeta / off;
+    const auto exact = pliant::host::fem::simulate_trajectory_sensitivities(problem, e, alpha, beta, options);
+    ASSERT_EQ(exact.sensitivity_m.size(), problem.frames.size());
+    const double h = 1e-4;
+    for (int j = 0; j < 3; ++j) {
+      const auto simulate = [&](double factor) {
+        const double ej = j == 0 ? e * factor : e;
+        const double aj = j == 1 ? alpha * factor : alpha;
+        const double bj = j == 2 ? beta * factor : beta;
+        return simulate_trajectory(problem, Eigen::VectorXd::Constant(problem.mesh.tet_count(), ej), aj, bj, options);
+      };
+      const auto plus = simulate(std::exp(h));
+      const auto minus = simulate(std::exp(-h));
+      double difference = 0, norm = 0;
+      for (std::size_t f = 1; f < problem.frames.size(); ++f) {
+        for (int node : problem.frames[f].observed_nodes) {
+          const Eigen::Vector3d fd = (plus[f].segment<3>(3 * node) - minus[f].segment<3>(3 * node)) / (2 * h);
+          difference += (exact.sensitivity_m[f][static_cast<std::size_t>(j)].segment<3>(3 * node) - fd).squaredNorm();
+          norm += fd.squaredNorm();
+        }
+      }
+      const double relative = std::sqrt(difference / norm);
+      std::printf("off %.1f parameter %d: relative difference %.3g\n", off, j, relative);
+      EXPECT_LT(relative, 5e-3) << "parameter " << j << " off " << off;
+    }
+  }
+}
+
+// The warm start of the noise-free bar is within the default noise floor (0.1 mm): the fit takes
+// one polishing step and says so. With a noise floor far below its misfit it iterates.
+TEST_F(FemEstimateDynamic, StopsAtTheWarmStartOnlyWhenItExplainsTheData) {
+  const FemRecordingProblem problem = fem_problem_from_recording(uniform_->recording);
+  TrajectoryEstimateOptions options = quick_options();
+  const TrajectoryEstimate stopped = estimate_trajectory_parameters(problem, options);
+  EXPECT_EQ(stopped.jacobian, "sensitivities");
+  EXPECT_TRUE(stopped.stopped_at_start) << stopped.stop_reason;
+  EXPECT_LT(stopped.start_chi_square_per_dof, stopped.explained_threshold);
+  EXPECT_NE(stopped.stop_reason.find("explains the data"), std::string::npos) << stopped.stop_reason;
+  EXPECT_TRUE(stopped.converged) << stopped.message;
+  EXPECT_LE(stopped.iterations, 2);  // Ceres counts its start as one
+  EXPECT_LT(stopped.residual_rms_m, stopped.start_residual_rms_m);
+  EXPECT_LT(relative_error(stopped.control_youngs_modulus_pa[0], kE), 1e-3);
+  for (double sd : stopped.standard_deviations) EXPECT_TRUE(std::isfinite(sd) && sd > 0);
+
+  options.position_noise_m = 0.05 * stopped.start_residual_rms_m;  // the start is 20 noise sd off
+  const TrajectoryEstimate fitted = estimate_trajectory_parameters(problem, options);
+  EXPECT_FALSE(fitted.stopped_at_start);
+  EXPECT_GT(fitted.start_chi_square_per_dof, 100.0);
+  EXPECT_NE(fitted.stop_reason.find("does not explain"), std::string::npos) << fitted.stop_reason;
+  EXPECT_GE(fitted.iterations, 1);
+  EXPECT_TRUE(fitted.converged) << fitted.message;
+  EXPECT_LT(fitted.residual_rms_m, stopped.residual_rms_m * 1.01);
+  EXPECT_LT(relative_error(fitted.control_youngs_modulus_pa[0], kE), 1e-3);
+
+  options.stop_when_explained = false;
+  options.position_noise_m = 1e-4;
+  const TrajectoryEstimate full = estimate_trajectory_parameters(problem, options);
+  EXPECT_FALSE(full.stopped_at_start);
+  EXPECT_TRUE(full.stop_reason.empty());
+  // The polished warm start is where the full fit ends (4 substeps leave alpha and beta a few
+  // percent off on this short record either way).
+  EXPECT_LT(relative_error(stopped.control_youngs_modulus_pa[0], full.control_youngs_modulus_pa[0]), 1e-5);
+  EXPECT_LT(relative_error(stopped.rayleigh_alpha, full.rayleigh_alpha), 1e-3);
+  EXPECT_LT(relative_error(stopped.rayleigh_beta, full.rayleigh_beta), 1e-3);
+  EXPECT_LT(stopped.simulations, full.simulations);
+}
+
+// The Jacobian's source: sensitivities by default, finite differences on request and where
+// sensitivities do not apply (a material map); asking for sensitivities there is refused.
+TEST_F(FemEstimateDynamic, SaysWhichJacobianItUses) {
+  const FemRecordingProblem problem = fem_problem_from_recording(uniform_->recording);
+  TrajectoryEstimateOptions options = quick_options();
+  options.jacobian = pliant::host::fem::TrajectoryJacobian::finite_differences;
+  const TrajectoryEstimate differences = estimate_trajectory_parameters(problem, options);
+  EXPECT_EQ(differences.jacobian, "finite differences (requested)");
+  EXPECT_LT(relative_error(differences.control_youngs_modulus_pa[0], kE), 1e-3);
+  options.jacobian = pliant::host::fem::TrajectoryJacobian::sensitivities;
+  options.simulation.integrator = FemIntegrator::backward_euler;
+  EXPECT_THROW(estimate_trajectory_parameters(problem, options), std::invalid_argument);
+  options.jacobian = pliant::host::fem::TrajectoryJacobian::automatic;
+  options.warm_start = false;
+  options.fit.max_iterations = 1;
+  EXPECT_EQ(estimate_trajectory_parameters(problem, options).jacobian, "finite differences (backward Euler)");
+}
+
 #else  // PLIANT_ESTIMATE_DYNAMIC_ACCEPTANCE
 
 // Table 1, bar with 1 control point, estimated with 1 control point, on the whole record with the

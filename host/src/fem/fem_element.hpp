@@ -54,6 +54,42 @@ inline void add_rotated_stiffness_product(const Mat34& c, double volume, double 
   }
 }
 
+/// Product of the element's exact corotational tangent (the polar factor's derivative included,
+/// which R K_e R^T drops) with corner vectors u_a: out_a += scale V dP b_a. With F = R S,
+/// dF = sum u_a b_a^T and W = R^T dF: (tr(S) I - S) omega = axial(W - W^T), dR = R [omega]x,
+/// dS = W - [omega]x S, and dP = R ([omega]x sigma(S - I) + sigma(dS)). Element formulation only.
+inline void add_exact_stiffness_product(const Eigen::Matrix3d& f, const Eigen::Matrix3d& r, const Mat34& b,
+                                        double volume, double mu, double lambda, const double* u,
+                                        const std::array<int, 4>& nodes, double scale, double* out) {
+  Eigen::Matrix3d s = r.transpose() * f;
+  s = 0.5 * (s + s.transpose());
+  const auto sigma = [mu, lambda](const Eigen::Matrix3d& strain) {
+    Eigen::Matrix3d t = 2.0 * mu * strain;
+    t.diagonal().array() += lambda * strain.trace();
+    return t;
+  };
+  Eigen::Matrix3d df = Eigen::Matrix3d::Zero();
+  for (int a = 0; a < 4; ++a) {
+    df.noalias() +=
+        Eigen::Map<const Eigen::Vector3d>(u + 3 * nodes[static_cast<std::size_t>(a)]) * b.col(a).transpose();
+  }
+  const Eigen::Matrix3d w = r.transpose() * df;
+  const Eigen::Vector3d axial(w(2, 1) - w(1, 2), w(0, 2) - w(2, 0), w(1, 0) - w(0, 1));
+  Eigen::Matrix3d g = -s;
+  g.diagonal().array() += s.trace();
+  const Eigen::Vector3d omega = g.inverse() * axial;
+  Eigen::Matrix3d spin;
+  spin << 0, -omega(2), omega(1), omega(2), 0, -omega(0), -omega(1), omega(0), 0;
+  Eigen::Matrix3d ds = w - spin * s;
+  ds = 0.5 * (ds + ds.transpose());
+  Eigen::Matrix3d strain = s;
+  strain.diagonal().array() -= 1.0;
+  const Mat34 contribution = (scale * volume) * (r * (spin * sigma(strain) + sigma(ds)) * b);
+  for (int a = 0; a < 4; ++a) {
+    Eigen::Map<Eigen::Vector3d>(out + 3 * nodes[static_cast<std::size_t>(a)]) += contribution.col(a);
+  }
+}
+
 /// Block (a, b) of R K_e R^T: V (lambda c_a c_b^T + mu c_b c_a^T + mu (b_a . b_b) I).
 inline Eigen::Matrix3d rotated_stiffness_block(const Mat34& c, const Mat34& b, int ia, int ib, double volume, double mu,
                                                double lambda) {

@@ -88,6 +88,8 @@ struct FemSolver::Impl {
   Eigen::VectorXd target;           // 3 * driven nodes
   Eigen::VectorXd previous_driven;  // 3 * driven nodes
   Eigen::VectorXd velocity_before;  // velocities at the start of the substep (driven nodes)
+  Eigen::VectorXd sensitivity;      // 3n: output of the sensitivity helpers
+  bool factorized = false;          // a factorization exists (solve_last_factorized)
 
   explicit Impl(const FemModel& m) : model(m) {}
 
@@ -149,6 +151,7 @@ struct FemSolver::Impl {
     const double mu1 = model.unit_mu();
     const double lambda1 = model.unit_element_lambda();
     double* values = cholesky.values();
+    if (matrix_scale > 0) factorized = false;  // the factor's storage is being reassembled
     if (nodal) nodal_pressure_pass(xs, wv);
     for (int e = 0; e < m; ++e) {
       const auto& nodes = model.elements()[uz(e)];
@@ -253,10 +256,12 @@ struct FemSolver::Impl {
   }
 
   void factorize_or_throw(const char* what) {
+    factorized = false;
     if (!cholesky.factorize()) {
       throw std::runtime_error(std::string("FemSolver: ") + what +
                                " matrix is not positive definite (is the body held against rigid motion?)");
     }
+    factorized = true;
   }
   // Solves the factorized system for -residual on the free DOFs into rhs; returns max |dx|.
   double solve_negative_residual() {
@@ -419,6 +424,98 @@ FemSolver::FemSolver(const FemModel& model, std::vector<int> fixed_nodes, std::v
   im.target.setZero(3 * static_cast<Eigen::Index>(driven_.size()));
   im.previous_driven.setZero(3 * static_cast<Eigen::Index>(driven_.size()));
   im.velocity_before.setZero(3 * n);
+}
+
+void FemSolver::solve_last_factorized(Eigen::Ref<Eigen::VectorXd> vector) {
+  Impl& im = *impl_;
+  if (!im.factorized) throw std::logic_error("FemSolver: nothing factorized yet");
+  if (vector.size() != model_->dof_count()) throw std::invalid_argument("FemSolver: vector must have 3n entries");
+  for (std::size_t k = 0; k < im.free_nodes.size(); ++k) {
+    im.rhs.segment<3>(3 * static_cast<Eigen::Index>(k)) = vector.segment<3>(3 * im.free_nodes[k]);
+  }
+  im.cholesky.solve(im.rhs);
+  for (int node : im.constrained) vector.segment<3>(3 * node).setZero();
+  for (std::size_t k = 0; k < im.free_nodes.size(); ++k) {
+    vector.segment<3>(3 * im.free_nodes[k]) = im.rhs.segment<3>(3 * static_cast<Eigen::Index>(k));
+  }
+}
+
+void FemSolver::add_tangent_product(const Eigen::Ref<const Eigen::VectorXd>& position_m,
+                                    const Eigen::Ref<const Eigen::VectorXd>& u, double scale,
+                                    Eigen::Ref<Eigen::VectorXd> out) {
+  Impl& im = *impl_;
+  const Eigen::Index dofs = model_->dof_count();
+  if (position_m.size() != dofs || u.size() != dofs || out.size() != dofs) {
+    throw std::invalid_argument("FemSolver: tangent product vectors must have 3n entries");
+  }
+  im.sensitivity.setZero(dofs);
+  im.element_pass(position_m.data(), u.data(), scale, 0.0, 0.0, im.sensitivity.data());
+  out += im.sensitivity;
+}
+
+void FemSolver::add_tangent_products(const Eigen::Ref<const Eigen::VectorXd>& position_m,
+                                     const std::vector<const Eigen::VectorXd*>& u, const std::vector<double>& scales,
+                                     const std::vector<Eigen::VectorXd*>& out, double force_scale,
+                                     Eigen::VectorXd* force_out, bool rotation_derivative) {
+  const FemModel& model = *model_;
+  const Eigen::Index dofs = model.dof_count();
+  if (u.size() != scales.size() || u.size() != out.size() || position_m.size() != dofs) {
+    throw std::invalid_argument("FemSolver: tangent products need one scale and output per vector, 3n positions");
+  }
+  for (std::size_t k = 0; k < u.size(); ++k) {
+    if (u[k]->size() != dofs || out[k]->size() != dofs) {
+      throw std::invalid_argument("FemSolver: tangent product vectors must have 3n entries");
+    }
+  }
+  if (force_out != nullptr && force_out->size() != dofs) {
+    throw std::invalid_argument("FemSolver: internal force vectors must have 3n entries");
+  }
+  if (model.nodal_volumetric()) {  // the nodal pressure rate is per vector: one pass each
+    for (std::size_t k = 0; k < u.size(); ++k) add_tangent_product(position_m, *u[k], scales[k], *out[k]);
+    if (force_out != nullptr) add_internal_force(position_m, force_scale, *force_out);
+    return;
+  }
+  const double mu1 = model.unit_mu();
+  const double lambda1 = model.unit_element_lambda();
+  const double* xs = position_m.data();
+  for (int e = 0; e < model.element_count(); ++e) {
+    const auto& nodes = model.elements()[uz(e)];
+    const detail::Mat34& b = model.shape_gradients(e);
+    const Eigen::Matrix3d f = detail::gather_gradient(xs, nodes, b);
+    const Eigen::Matrix3d r = polar_rotation(f);
+    const double youngs = model.youngs_modulus_pa()[e];
+    const double mu = youngs * mu1;
+    const double lambda = youngs * lambda1;
+    const double volume = model.element_volume_m3()[e];
+    if (force_out != nullptr) {
+      const Eigen::Matrix3d p = detail::corotated_stress(f, r, mu, lambda, nullptr);
+      const detail::Mat34 corner = (-force_scale * volume) * (p * b);
+      for (int a = 0; a < 4; ++a) force_out->segment<3>(3 * nodes[uz(a)]) += corner.col(a);
+    }
+    if (rotation_derivative) {
+      for (std::size_t k = 0; k < u.size(); ++k) {
+        detail::add_exact_stiffness_product(f, r, b, volume, mu, lambda, u[k]->data(), nodes, scales[k],
+                                            out[k]->data());
+      }
+      continue;
+    }
+    const detail::Mat34 c = r * b;
+    for (std::size_t k = 0; k < u.size(); ++k) {
+      detail::add_rotated_stiffness_product(c, volume, mu, lambda, u[k]->data(), nodes, scales[k], out[k]->data());
+    }
+  }
+}
+
+void FemSolver::add_internal_force(const Eigen::Ref<const Eigen::VectorXd>& position_m, double scale,
+                                   Eigen::Ref<Eigen::VectorXd> out) {
+  Impl& im = *impl_;
+  const Eigen::Index dofs = model_->dof_count();
+  if (position_m.size() != dofs || out.size() != dofs) {
+    throw std::invalid_argument("FemSolver: internal force vectors must have 3n entries");
+  }
+  im.sensitivity.setZero(dofs);
+  im.element_pass(position_m.data(), nullptr, 0.0, -scale, 0.0, im.sensitivity.data());
+  out += im.sensitivity;
 }
 
 FemSolver::~FemSolver() = default;

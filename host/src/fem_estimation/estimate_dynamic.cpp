@@ -4,8 +4,10 @@
 #include "pliant/host/fem/estimate_dynamic.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <ctime>
 #include <deque>
 #include <functional>
@@ -15,6 +17,10 @@
 #include <stdexcept>
 #include <thread>
 #include <utility>
+
+#include <Eigen/Dense>
+
+#include "trajectory_sensitivity.hpp"
 
 namespace pliant::host::fem {
 namespace {
@@ -80,15 +86,34 @@ void check_simulation_options(const TrajectorySimulationOptions& options) {
   }
 }
 
-// One thread's model and solvers; runs whole recordings.
+// Thrown inside a simulation whose result is no longer wanted (SensitivityEvaluator).
+struct Cancelled {};
+
+// Outputs of one simulation; null pointers are not filled.
+struct SimulationOutput {
+  double* residuals = nullptr;                        // (sim - obs) * inverse_noise, frame-major
+  std::vector<Eigen::VectorXd>* positions = nullptr;  // every frame
+  // With sensitivities: d residual / d log(theta_j), residual-major (residual count x p).
+  Eigen::MatrixXd* jacobian = nullptr;
+  // With sensitivities: d position / d log(theta_j) per frame and parameter (frame 0 included).
+  std::vector<std::vector<Eigen::VectorXd>>* position_sensitivities = nullptr;
+  const std::atomic<bool>* cancel = nullptr;  // checked once per frame
+};
+
+// One thread's model and solvers; runs whole recordings. With `sensitivities` (non-empty), every
+// run steps one substep per FemSolver::step call (so that runs with and without the Jacobian give
+// the same residuals) and can propagate d x / d log(theta).
 class Simulator {
  public:
-  Simulator(const FemRecordingProblem& problem, const Layout& layout, const TrajectorySimulationOptions& options)
+  Simulator(const FemRecordingProblem& problem, const Layout& layout, const TrajectorySimulationOptions& options,
+            std::vector<detail::SensitivityParameter> sensitivities = {})
       : problem_(problem),
         layout_(layout),
         options_(options),
         model_(problem.mesh, problem.material),
-        dynamic_(model_, layout.fixed, layout.driven) {
+        dynamic_(model_, layout.fixed, layout.driven),
+        per_substep_(!sensitivities.empty()),
+        sensitivity_(std::move(sensitivities)) {
     if (!layout.unobserved_free_0.empty()) {
       fill_driven_ = layout.driven;
       fill_driven_.insert(fill_driven_.end(), layout.observed_free_0.begin(), layout.observed_free_0.end());
@@ -100,31 +125,57 @@ class Simulator {
   // and/or positions (every frame). Throws std::runtime_error on solver failure.
   void run(const Eigen::Ref<const Eigen::VectorXd>& element_youngs_pa, double alpha, double beta, double inverse_noise,
            double* residuals, std::vector<Eigen::VectorXd>* positions) {
+    SimulationOutput output;
+    output.residuals = residuals;
+    output.positions = positions;
+    run(element_youngs_pa, alpha, beta, inverse_noise, output);
+  }
+
+  void run(const Eigen::Ref<const Eigen::VectorXd>& element_youngs_pa, double alpha, double beta, double inverse_noise,
+           const SimulationOutput& output) {
     model_.set_youngs_modulus(element_youngs_pa);
     model_.set_rayleigh(alpha, beta);
     const std::vector<FemFrame>& frames = problem_.frames;
+    const bool sensitive = output.jacobian != nullptr || output.position_sensitivities != nullptr;
+    if (sensitive && !per_substep_) throw std::logic_error("trajectory simulation: no sensitivities configured");
     FemState state = dynamic_.rest_state();
     initial_state(state);
-    if (positions != nullptr) {
-      positions->assign(frames.size(), Eigen::VectorXd());
-      positions->front() = state.position_m;
+    if (sensitive) sensitivity_.start(fill_.get(), dynamic_, state.position_m);
+    if (output.positions != nullptr) {
+      output.positions->assign(frames.size(), Eigen::VectorXd());
+      output.positions->front() = state.position_m;
+    }
+    if (output.jacobian != nullptr) output.jacobian->setZero(layout_.residual_count, sensitivity_.parameter_count());
+    if (output.position_sensitivities != nullptr) {
+      output.position_sensitivities->assign(frames.size(), {});
+      keep_sensitivities((*output.position_sensitivities)[0]);
     }
     FemStepOptions step;
     step.integrator = options_.integrator;
-    step.substeps = options_.substeps;
+    step.substeps = per_substep_ ? 1 : options_.substeps;
     step.newton_iterations = options_.newton_iterations;
     step.extrapolated_newton_start = options_.extrapolated_newton_start;
     std::size_t r = 0;
     for (std::size_t f = 1; f < frames.size(); ++f) {
+      if (output.cancel != nullptr && output.cancel->load(std::memory_order_relaxed)) throw Cancelled{};
       const double dt = frames[f].time_s - frames[f - 1].time_s;
       const bool loaded = external_load(frames[f], state.position_m);
-      dynamic_.step(state, dt, frames[f].driven_position_m, loaded ? load_ : empty_, step);
-      if (positions != nullptr) (*positions)[f] = state.position_m;
-      if (residuals != nullptr) {
-        for (int node : layout_.residual_nodes[f]) {
-          for (int a = 0; a < 3; ++a) {
-            const Eigen::Index i = 3 * ei(node) + a;
-            residuals[r++] = (state.position_m[i] - frames[f].observed_position_m[i]) * inverse_noise;
+      if (per_substep_) {
+        substeps(state, dt, frames[f].driven_position_m, loaded ? load_ : empty_, step, sensitive);
+      } else {
+        dynamic_.step(state, dt, frames[f].driven_position_m, loaded ? load_ : empty_, step);
+      }
+      if (output.positions != nullptr) (*output.positions)[f] = state.position_m;
+      if (output.position_sensitivities != nullptr) keep_sensitivities((*output.position_sensitivities)[f]);
+      for (int node : layout_.residual_nodes[f]) {
+        for (int a = 0; a < 3; ++a, ++r) {
+          const Eigen::Index i = 3 * ei(node) + a;
+          if (output.residuals != nullptr) {
+            output.residuals[r] = (state.position_m[i] - frames[f].observed_position_m[i]) * inverse_noise;
+          }
+          if (output.jacobian == nullptr) continue;
+          for (int j = 0; j < sensitivity_.parameter_count(); ++j) {
+            (*output.jacobian)(static_cast<Eigen::Index>(r), j) = sensitivity_.position(j)[i] * inverse_noise;
           }
         }
       }
@@ -132,6 +183,33 @@ class Simulator {
   }
 
  private:
+  void keep_sensitivities(std::vector<Eigen::VectorXd>& out) const {
+    out.clear();
+    for (int j = 0; j < sensitivity_.parameter_count(); ++j) out.push_back(sensitivity_.position(j));
+  }
+
+  // One frame interval as options_.substeps calls of one substep each (the driven positions
+  // interpolated linearly, as FemSolver::step does), carrying the sensitivities along.
+  void substeps(FemState& state, double dt, const Eigen::VectorXd& driven_end, const Eigen::VectorXd& load,
+                const FemStepOptions& step, bool sensitive) {
+    driven_start_.resize(driven_end.size());
+    for (std::size_t k = 0; k < layout_.driven.size(); ++k) {
+      driven_start_.segment<3>(3 * static_cast<Eigen::Index>(k)) = state.position_m.segment<3>(3 * layout_.driven[k]);
+    }
+    const int count = options_.substeps;
+    const double h = dt / count;
+    for (int sub = 1; sub <= count; ++sub) {
+      const double fraction = static_cast<double>(sub) / count;
+      driven_target_ = driven_start_ + fraction * (driven_end - driven_start_);
+      if (sensitive) {
+        substep_start_ = state.position_m;
+        substep_velocity_ = state.velocity_m_s;
+      }
+      dynamic_.step(state, h, driven_target_, load, step);
+      if (sensitive) sensitivity_.substep(dynamic_, substep_start_, substep_velocity_, state.position_m, h);
+    }
+  }
+
   // The wrench of a frame as nodal loads, when it is an applied load (see the header).
   bool external_load(const FemFrame& frame, const Eigen::VectorXd& position_m) {
     if (!layout_.use_wrench || !frame.has_wrench) return false;
@@ -216,6 +294,9 @@ class Simulator {
   std::unique_ptr<FemSolver> fill_;
   Eigen::VectorXd load_;
   const Eigen::VectorXd empty_;
+  bool per_substep_ = false;
+  detail::TrajectorySensitivity sensitivity_;
+  Eigen::VectorXd driven_start_, driven_target_, substep_start_, substep_velocity_;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -413,6 +494,233 @@ class LookAheadEvaluator {
   int simulations_ = 0;
 };
 
+// ---------------------------------------------------------------------------------------------
+// Residual evaluation with exact Jacobians (forward sensitivities). fit_least_squares asks for the
+// residuals at a trial point and, once it accepts the point, for the Jacobian there. A Jacobian
+// run also yields the residuals, so a trial point is simulated with its sensitivities at once:
+// steps are mostly accepted, and a plain run beside it (on the other core) would only cost CPU
+// time. A run at a point the optimiser has left is cancelled at its next frame.
+
+struct SensitiveEvaluation {
+  std::vector<double> values;
+  std::vector<double> residuals;
+  Eigen::MatrixXd jacobian;  // d residual / d log(theta); empty for a residual-only run
+  bool with_jacobian = false;
+  bool ok = false;
+  bool cancelled = false;
+};
+
+class SensitivityEvaluator {
+ public:
+  using Run = std::function<bool(Simulator&, const std::vector<double>&, std::vector<double>&, Eigen::MatrixXd*,
+                                 const std::atomic<bool>*)>;
+
+  SensitivityEvaluator(std::vector<std::unique_ptr<Simulator>> simulators, Run run)
+      : simulators_(std::move(simulators)), busy_(simulators_.size(), false), run_(std::move(run)) {}
+  ~SensitivityEvaluator() {
+    for (Job& job : jobs_) {
+      job.cancel->store(true);
+      job.future.wait();
+    }
+  }
+  SensitivityEvaluator(const SensitivityEvaluator&) = delete;
+  SensitivityEvaluator& operator=(const SensitivityEvaluator&) = delete;
+
+  // Residuals at `values`. With `speculate` (a trial point of the optimiser, usually accepted,
+  // and then its Jacobian is asked for next) the run carries the sensitivities: one run instead
+  // of a plain one followed by a Jacobian run.
+  bool evaluate(const std::vector<double>& values, std::vector<double>& residuals, bool speculate = true) {
+    reap();
+    if (const SensitiveEvaluation* done = find_done(values, false)) {
+      residuals = done->residuals;
+      return done->ok;
+    }
+    cancel_other(values);
+    if (find_job(values, true) == jobs_.end() && find_job(values, false) == jobs_.end()) {
+      launch(values, speculate, acquire_slot());
+    }
+    while (find_done(values, false) == nullptr) wait_any_at(values);
+    const SensitiveEvaluation* done = find_done(values, false);
+    residuals = done->residuals;
+    return done->ok;
+  }
+
+  // Residuals and d residual / d log(theta) at `values`.
+  bool jacobian(const std::vector<double>& values, std::vector<double>& residuals, Eigen::MatrixXd& jacobian) {
+    reap();
+    cancel_other(values);
+    if (find_done(values, true) == nullptr && find_job(values, true) == jobs_.end()) {
+      launch(values, true, acquire_slot());
+    }
+    while (find_done(values, true) == nullptr) wait_any_at(values);
+    const SensitiveEvaluation* done = find_done(values, true);
+    residuals = done->residuals;
+    jacobian = done->jacobian;
+    return done->ok;
+  }
+
+  int simulations() const { return simulations_; }
+
+ private:
+  struct Job {
+    std::vector<double> values;
+    bool with_jacobian = false;
+    int slot = 0;
+    std::shared_ptr<std::atomic<bool>> cancel;
+    std::future<SensitiveEvaluation> future;
+  };
+
+  // Equal to 1e-12 relative: the optimiser's exp(log x) and the caller's x differ in the last bit.
+  static bool same(const std::vector<double>& a, const std::vector<double>& b) {
+    for (std::size_t j = 0; j < a.size(); ++j) {
+      if (std::abs(a[j] - b[j]) > 1e-12 * std::max(std::abs(a[j]), std::abs(b[j]))) return false;
+    }
+    return true;
+  }
+
+  const SensitiveEvaluation* find_done(const std::vector<double>& values, bool need_jacobian) const {
+    for (const SensitiveEvaluation& e : done_) {
+      if (same(e.values, values) && (!need_jacobian || e.with_jacobian || !e.ok)) return &e;
+    }
+    return nullptr;
+  }
+
+  std::deque<Job>::iterator find_job(const std::vector<double>& values, bool with_jacobian) {
+    return std::find_if(jobs_.begin(), jobs_.end(),
+                        [&](const Job& job) { return job.with_jacobian == with_jacobian && same(job.values, values); });
+  }
+
+  int free_slot() const {
+    for (std::size_t s = 0; s < busy_.size(); ++s) {
+      if (!busy_[s]) return static_cast<int>(s);
+    }
+    return -1;
+  }
+
+  // A free slot, waiting for the oldest run when every thread is busy.
+  int acquire_slot() {
+    while (free_slot() < 0) collect(jobs_.begin());
+    return free_slot();
+  }
+
+  // Runs at other points are no longer wanted (the optimiser moved on).
+  void cancel_other(const std::vector<double>& values) {
+    for (Job& job : jobs_) {
+      if (!same(job.values, values)) job.cancel->store(true);
+    }
+  }
+
+  void launch(const std::vector<double>& values, bool with_jacobian, int slot) {
+    busy_[uz(slot)] = true;
+    ++simulations_;
+    Simulator* simulator = simulators_[uz(slot)].get();
+    const Run* run = &run_;
+    Job job;
+    job.values = values;
+    job.with_jacobian = with_jacobian;
+    job.slot = slot;
+    job.cancel = std::make_shared<std::atomic<bool>>(false);
+    const std::atomic<bool>* cancel = job.cancel.get();
+    job.future = std::async(std::launch::async, [simulator, run, values, with_jacobian, cancel]() {
+      SensitiveEvaluation e;
+      e.values = values;
+      e.with_jacobian = with_jacobian;
+      try {
+        e.ok = (*run)(*simulator, values, e.residuals, with_jacobian ? &e.jacobian : nullptr, cancel);
+      } catch (const Cancelled&) {
+        e.cancelled = true;
+      }
+      return e;
+    });
+    jobs_.push_back(std::move(job));
+  }
+
+  void collect(std::deque<Job>::iterator job) {
+    SensitiveEvaluation e = job->future.get();
+    busy_[uz(job->slot)] = false;
+    jobs_.erase(job);
+    if (e.cancelled) return;
+    done_.push_back(std::move(e));
+    while (done_.size() > 8) done_.pop_front();
+  }
+
+  void reap() {
+    for (auto it = jobs_.begin(); it != jobs_.end();) {
+      if (it->future.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
+        collect(it);
+        it = jobs_.begin();
+      } else {
+        ++it;
+      }
+    }
+  }
+
+  // Waits until some run at `values` finishes (the caller checks whether it is the one needed).
+  void wait_any_at(const std::vector<double>& values) {
+    while (true) {
+      for (auto it = jobs_.begin(); it != jobs_.end(); ++it) {
+        if (same(it->values, values) &&
+            it->future.wait_for(std::chrono::milliseconds(2)) == std::future_status::ready) {
+          collect(it);
+          return;
+        }
+      }
+      if (std::none_of(jobs_.begin(), jobs_.end(), [&](const Job& job) { return same(job.values, values); })) {
+        throw std::logic_error("trajectory estimate: no run at the requested point");
+      }
+      reap();
+    }
+  }
+
+  std::vector<std::unique_ptr<Simulator>> simulators_;
+  std::vector<bool> busy_;
+  Run run_;
+  std::deque<Job> jobs_;
+  std::deque<SensitiveEvaluation> done_;
+  int simulations_ = 0;
+};
+
+// The fit's view of either evaluator.
+struct Evaluator {
+  std::unique_ptr<LookAheadEvaluator> look_ahead;
+  std::unique_ptr<SensitivityEvaluator> sensitive;
+
+  bool evaluate(const std::vector<double>& values, std::vector<double>& residuals, bool speculate = true) {
+    return sensitive ? sensitive->evaluate(values, residuals, speculate)
+                     : look_ahead->evaluate(values, residuals, speculate);
+  }
+  // The starting point: with sensitivities, its Jacobian too.
+  bool start(const std::vector<double>& values, std::vector<double>& residuals, bool speculate) {
+    if (!sensitive) return look_ahead->evaluate(values, residuals, speculate);
+    Eigen::MatrixXd jacobian;
+    return sensitive->jacobian(values, residuals, jacobian);
+  }
+  FitResult fit(const std::vector<FitParameter>& parameters, int residual_count, const FitOptions& options) {
+    const ResidualFunction residuals = [this](const std::vector<double>& values, std::vector<double>& out) {
+      return evaluate(values, out);
+    };
+    if (!sensitive) return fit_least_squares(parameters, residual_count, residuals, options);
+    const JacobianFunction jacobian = [this](const std::vector<double>& values, std::vector<double>& out,
+                                             Eigen::MatrixXd& matrix) {
+      if (!sensitive->jacobian(values, out, matrix)) return false;
+      for (Eigen::Index j = 0; j < matrix.cols(); ++j) matrix.col(j) /= values[static_cast<std::size_t>(j)];
+      return true;
+    };
+    return fit_least_squares(parameters, residual_count, residuals, jacobian, options);
+  }
+  int simulations() const { return sensitive ? sensitive->simulations() : look_ahead->simulations(); }
+};
+
+// Why forward sensitivities do not cover this configuration ("" when they do).
+std::string sensitivities_unavailable(const TrajectoryEstimateOptions& options, const Layout& layout,
+                                      bool material_map) {
+  if (material_map) return "material map";
+  if (options.simulation.integrator != FemIntegrator::newmark) return "backward Euler";
+  if (options.simulation.initial_velocity != InitialVelocity::at_rest) return "initial velocity from the data";
+  if (layout.use_wrench) return "measured wrench applied as a load";
+  return "";
+}
+
 double rms(const std::vector<double>& r, double scale) {
   double s = 0;
   for (double x : r) s += x * x;
@@ -439,6 +747,28 @@ std::vector<Eigen::VectorXd> simulate_trajectory(const FemRecordingProblem& prob
   std::vector<Eigen::VectorXd> positions;
   simulator.run(element_youngs_modulus_pa, rayleigh_alpha, rayleigh_beta, 1.0, nullptr, &positions);
   return positions;
+}
+
+TrajectorySensitivities simulate_trajectory_sensitivities(const FemRecordingProblem& problem, double youngs_modulus_pa,
+                                                          double rayleigh_alpha, double rayleigh_beta,
+                                                          const TrajectorySimulationOptions& options) {
+  check_simulation_options(options);
+  const Layout layout = make_layout(problem);
+  TrajectoryEstimateOptions estimate;
+  estimate.simulation = options;
+  const std::string unavailable = sensitivities_unavailable(estimate, layout, false);
+  if (!unavailable.empty()) throw std::invalid_argument("simulate_trajectory_sensitivities: " + unavailable);
+  Simulator simulator(
+      problem, layout, options,
+      {detail::SensitivityParameter::log_youngs_modulus, detail::SensitivityParameter::log_rayleigh_alpha,
+       detail::SensitivityParameter::log_rayleigh_beta});
+  TrajectorySensitivities out;
+  SimulationOutput output;
+  output.positions = &out.position_m;
+  output.position_sensitivities = &out.sensitivity_m;
+  simulator.run(Eigen::VectorXd::Constant(problem.mesh.tet_count(), youngs_modulus_pa), rayleigh_alpha, rayleigh_beta,
+                1.0, output);
+  return out;
 }
 
 TrajectoryEstimate estimate_trajectory_parameters(const FemRecordingProblem& problem,
@@ -537,20 +867,59 @@ TrajectoryEstimate estimate_trajectory_parameters(const FemRecordingProblem& pro
   };
   int threads = options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency());
   threads = std::max(threads, 1);
+
+  // Which Jacobian: forward sensitivities where they are exact to the linearised step.
+  std::vector<detail::SensitivityParameter> sensitive;
+  if (fit_modulus) sensitive.push_back(detail::SensitivityParameter::log_youngs_modulus);
+  if (fit_alpha) sensitive.push_back(detail::SensitivityParameter::log_rayleigh_alpha);
+  if (fit_beta) sensitive.push_back(detail::SensitivityParameter::log_rayleigh_beta);
+  const std::string no_sensitivities = sensitivities_unavailable(options, layout, map != nullptr && fit_modulus);
+  if (options.jacobian == TrajectoryJacobian::sensitivities && !no_sensitivities.empty()) {
+    throw std::invalid_argument(label + "sensitivities are not available: " + no_sensitivities);
+  }
+  const bool use_sensitivities = options.jacobian != TrajectoryJacobian::finite_differences && no_sensitivities.empty();
+  if (!use_sensitivities) sensitive.clear();
+  result.jacobian = use_sensitivities ? "sensitivities"
+                    : options.jacobian == TrajectoryJacobian::finite_differences
+                        ? "finite differences (requested)"
+                        : "finite differences (" + no_sensitivities + ")";
+
   // One evaluator per time window (continuation), each with its own simulators.
   const auto make_evaluator = [&](const FemRecordingProblem& window, const Layout& window_layout) {
     std::vector<std::unique_ptr<Simulator>> simulators;
     for (int t = 0; t < threads; ++t) {
-      simulators.push_back(std::make_unique<Simulator>(window, window_layout, options.simulation));
+      simulators.push_back(std::make_unique<Simulator>(window, window_layout, options.simulation, sensitive));
     }
     const int count = window_layout.residual_count;
-    LookAheadEvaluator::Run sized = [run, count](Simulator& simulator, const std::vector<double>& values,
-                                                 std::vector<double>& residuals) {
-      residuals.assign(uz(count), kNaN);
-      return run(simulator, values, residuals);
-    };
-    return std::make_unique<LookAheadEvaluator>(std::move(simulators), sized, parameters, options.fit.difference_step,
-                                                options.fit.central_differences);
+    auto evaluator = std::make_unique<Evaluator>();
+    if (use_sensitivities) {
+      SensitivityEvaluator::Run sized = [&, count](Simulator& simulator, const std::vector<double>& values,
+                                                   std::vector<double>& residuals, Eigen::MatrixXd* jacobian,
+                                                   const std::atomic<bool>* cancel) {
+        residuals.assign(uz(count), kNaN);
+        try {
+          const auto [alpha, beta] = damping(values);
+          SimulationOutput output;
+          output.residuals = residuals.data();
+          output.jacobian = jacobian;
+          output.cancel = cancel;
+          simulator.run(element_moduli(values), alpha, beta, inverse_noise, output);
+          return true;
+        } catch (const std::exception&) {
+          return false;
+        }
+      };
+      evaluator->sensitive = std::make_unique<SensitivityEvaluator>(std::move(simulators), sized);
+    } else {
+      LookAheadEvaluator::Run sized = [run, count](Simulator& simulator, const std::vector<double>& values,
+                                                   std::vector<double>& residuals) {
+        residuals.assign(uz(count), kNaN);
+        return run(simulator, values, residuals);
+      };
+      evaluator->look_ahead = std::make_unique<LookAheadEvaluator>(
+          std::move(simulators), sized, parameters, options.fit.difference_step, options.fit.central_differences);
+    }
+    return evaluator;
   };
 
   // Continuation: fit the leading part of the record first (fewer periods, so a start that is off
@@ -564,22 +933,50 @@ TrajectoryEstimate estimate_trajectory_parameters(const FemRecordingProblem& pro
 
   const auto evaluator = make_evaluator(problem, layout);
   std::vector<double> start_residuals;
-  // Without windows the whole-record fit starts here, so its first Jacobian's points may start
-  // on the idle threads while this one runs.
-  if (!evaluator->evaluate(result.start_values, start_residuals, windows.empty())) {
+  // The start: with sensitivities its Jacobian comes with it (the fit's first, or the polish's);
+  // with finite differences and no windows, the first Jacobian's points start on idle threads.
+  if (!evaluator->start(result.start_values, start_residuals, windows.empty())) {
     throw std::runtime_error(label + "the simulation fails at the starting values");
   }
   result.start_residual_rms_m = rms(start_residuals, options.position_noise_m);
+
+  // Does the start already explain the data within the noise?
+  const int dof = std::max(1, layout.residual_count - static_cast<int>(parameters.size()));
+  double chi_square = 0;
+  for (double r : start_residuals) chi_square += r * r;
+  result.start_chi_square_per_dof = chi_square / dof;
+  result.explained_threshold = 1.0 + 3.0 * std::sqrt(2.0 / dof);
+  const bool warm_started =
+      options.warm_start && (result.warm_start.modulus_matched || result.warm_start.damping_matched);
+  result.stopped_at_start =
+      options.stop_when_explained && warm_started && result.start_chi_square_per_dof <= result.explained_threshold;
+
+  FitOptions fit_options = options.fit;
+  if (result.stopped_at_start) {
+    // One polishing step from the warm start, no more; no windows.
+    windows.clear();
+    fit_options.max_iterations = 1;
+    fit_options.projected_line_search = false;
+    char line[256];
+    std::snprintf(line, sizeof line,
+                  "the warm start explains the data within the noise (chi-square per degree of freedom %.3g <= "
+                  "%.3g at position_noise_m %.3g m): one polishing step, no iterations",
+                  result.start_chi_square_per_dof, result.explained_threshold, options.position_noise_m);
+    result.stop_reason = line;
+  } else if (options.stop_when_explained && warm_started) {
+    char line[256];
+    std::snprintf(line, sizeof line,
+                  "the warm start does not explain the data (chi-square per degree of freedom %.3g > %.3g): fitted",
+                  result.start_chi_square_per_dof, result.explained_threshold);
+    result.stop_reason = line;
+  }
 
   for (double fraction : windows) {
     FemRecordingProblem window = problem;
     window.frames.resize(uz(std::max(3, static_cast<int>(std::ceil(fraction * frame_count)))));
     const Layout window_layout = make_layout(window);
     const auto window_evaluator = make_evaluator(window, window_layout);
-    const ResidualFunction residuals = [&](const std::vector<double>& values, std::vector<double>& out) {
-      return window_evaluator->evaluate(values, out);
-    };
-    const FitResult partial = fit_least_squares(parameters, window_layout.residual_count, residuals, options.fit);
+    const FitResult partial = window_evaluator->fit(parameters, window_layout.residual_count, options.fit);
     for (std::size_t j = 0; j < parameters.size(); ++j) {
       parameters[j].initial = inside(partial.values[j], parameters[j].lower, parameters[j].upper);
     }
@@ -588,13 +985,14 @@ TrajectoryEstimate estimate_trajectory_parameters(const FemRecordingProblem& pro
     result.simulations += window_evaluator->simulations();
   }
 
-  const ResidualFunction residuals = [&](const std::vector<double>& values, std::vector<double>& out) {
-    return evaluator->evaluate(values, out);
-  };
-  result.fit = fit_least_squares(parameters, layout.residual_count, residuals, options.fit);
+  result.fit = evaluator->fit(parameters, layout.residual_count, fit_options);
   std::vector<double> final_residuals;
   evaluator->evaluate(result.fit.values, final_residuals, false);
   result.residual_rms_m = rms(final_residuals, options.position_noise_m);
+  if (result.stopped_at_start) {
+    result.fit.converged = true;  // by the noise test, not by a tolerance
+    result.fit.message = result.stop_reason + "; " + result.fit.message;
+  }
   result.simulations += evaluator->simulations();
 
   result.names = result.fit.names;

@@ -332,6 +332,10 @@ class FramePool {
         return e.converged;
       }
     }
+    if (scale_by_modulus_ && driven_position == nullptr && load.size() == 0 &&
+        reuse_scaled(c, youngs_modulus_pa, key)) {
+      return true;
+    }
     w.model->set_youngs_modulus(youngs_modulus_pa);  // O(elements), negligible beside a solve
     Eigen::VectorXd start = predict_start(c, key, rest_, through_rest);
     if (start.size() == 0 && previous >= 0 && cache_[uz(static_cast<int>(previous))].valid) {
@@ -377,6 +381,11 @@ class FramePool {
     c.use(c.memo.back(), false);
     return c.converged;
   }
+
+  // Prescribed displacements alone (no load, no gravity): f_int(x; E) = E f_int(x; 1), so the
+  // equilibrium does not depend on E and the reactions are proportional to it. Then a frame solved
+  // once at any E is solved at every E (the fit's other evaluations cost no static solve).
+  void set_scale_by_modulus(bool on) { scale_by_modulus_ = on; }
 
   // Every plan at E with its own constant load. False when a solve failed or did not converge.
   // Key: the compliance 1 / E; through_rest for force loading (displacement proportional to it).
@@ -430,6 +439,23 @@ class FramePool {
   FemStaticOptions static_options_;
   Eigen::VectorXd rest_;
   double residual_tolerance_per_pa_ = 0;  // automatic residual tolerance / E; 0: the caller's
+  bool scale_by_modulus_ = false;
+
+  // The frame's converged solution at another E, its reactions scaled to E (set_scale_by_modulus).
+  static bool reuse_scaled(FrameCache& c, double youngs_modulus_pa, const Eigen::VectorXd& key) {
+    for (const MemoEntry& e : c.memo) {
+      if (!e.converged || !(e.youngs_modulus_pa > 0)) continue;
+      MemoEntry scaled = e;
+      scaled.key = key;
+      scaled.youngs_modulus_pa = youngs_modulus_pa;
+      scaled.tool_force = (youngs_modulus_pa / e.youngs_modulus_pa) * e.tool_force;
+      c.memo.push_back(std::move(scaled));
+      if (c.memo.size() > kMemoSize) c.memo.erase(c.memo.begin());
+      c.use(c.memo.back(), true);
+      return true;
+    }
+    return false;
+  }
 };
 
 int position_residual_count(const std::vector<FramePlan>& plans) {
@@ -749,6 +775,8 @@ YoungsModulusEstimate estimate_youngs_modulus_from_reaction(const FemRecordingPr
   const int force_count = static_cast<int>(plans.size() * axes.size());
   const int position_count = options.position_weight > 0 ? position_residual_count(plans) : 0;
   FramePool pool(problem, std::move(plans), options.threads, options.static_options, initial);
+  // Without gravity the prescribed displacements alone set the shape (no load is applied here).
+  pool.set_scale_by_modulus(problem.material.gravity_m_s2.isZero(0.0));
 
   // Parameters: youngs_modulus, then (fit_force_offset) one offset per fitted axis.
   Eigen::Vector3d offset = Eigen::Vector3d::Zero();

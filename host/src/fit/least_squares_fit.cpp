@@ -37,8 +37,9 @@ struct Coordinates {
 // model run is never repeated.
 class ModelEvaluator {
  public:
-  ModelEvaluator(const Coordinates& coordinates, int residual_count, const ResidualFunction& f)
-      : coordinates_(coordinates), residual_count_(residual_count), function_(f) {}
+  ModelEvaluator(const Coordinates& coordinates, int residual_count, const ResidualFunction& f,
+                 const JacobianFunction* exact = nullptr)
+      : coordinates_(coordinates), residual_count_(residual_count), function_(f), exact_(exact) {}
 
   // Residuals at a point (remembered), the optimiser's trial points and the solution.
   bool evaluate(const double* internal, std::vector<double>& residuals) const {
@@ -62,6 +63,7 @@ class ModelEvaluator {
                 double* out, const std::vector<bool>& skip = {}) const {
     const int n = parameter_count();
     const std::vector<double> center(internal, internal + n);
+    if (exact_ != nullptr) return exact_jacobian(center, out, skip);
     for (int j = 0; j < n; ++j) {
       std::vector<double> column;
       const bool skipped = !skip.empty() && skip[static_cast<size_t>(j)];
@@ -110,6 +112,39 @@ class ModelEvaluator {
     return false;
   }
 
+  // The caller's exact Jacobian at `center` (remembered), in internal coordinates.
+  bool exact_jacobian(const std::vector<double>& center, double* out, const std::vector<bool>& skip) const {
+    const int n = parameter_count();
+    if (exact_center_ != center || !exact_ok_) {
+      values_.resize(static_cast<size_t>(n));
+      for (int j = 0; j < n; ++j)
+        values_[static_cast<size_t>(j)] = coordinates_.to_value(j, center[static_cast<size_t>(j)]);
+      std::vector<double> residuals(static_cast<size_t>(residual_count_), 0.0);
+      ++evaluations_;
+      exact_center_ = center;
+      exact_ok_ = (*exact_)(values_, residuals, exact_matrix_) &&
+                  residuals.size() == static_cast<size_t>(residual_count_) && exact_matrix_.rows() == residual_count_ &&
+                  exact_matrix_.cols() == n && exact_matrix_.allFinite() &&
+                  std::all_of(residuals.begin(), residuals.end(), [](double r) { return std::isfinite(r); });
+      if (!exact_ok_) return false;
+      for (int j = 0; j < n; ++j) {
+        // d r / d internal: log-scale coordinates carry the chain factor d value / d log value.
+        if ((*coordinates_.parameters)[static_cast<size_t>(j)].log_scale)
+          exact_matrix_.col(j) *= values_[static_cast<size_t>(j)];
+      }
+      if (remembered_.size() == kRemembered) remembered_.erase(remembered_.begin());
+      remembered_.push_back({center, residuals, true});
+    }
+    for (int i = 0; i < residual_count_; ++i) {
+      for (int j = 0; j < n; ++j) {
+        const bool skipped = !skip.empty() && skip[static_cast<size_t>(j)];
+        out[static_cast<size_t>(i) * static_cast<size_t>(n) + static_cast<size_t>(j)] =
+            skipped ? 0.0 : exact_matrix_(i, j);
+      }
+    }
+    return true;
+  }
+
   // Column j of the Jacobian by differences around `internal`, where the residuals are `at`.
   bool difference_column(const double* internal, const std::vector<double>& at, double difference_step, bool central,
                          int j, std::vector<double>& column) const {
@@ -152,6 +187,10 @@ class ModelEvaluator {
   const Coordinates& coordinates_;
   int residual_count_;
   const ResidualFunction& function_;
+  const JacobianFunction* exact_;
+  mutable std::vector<double> exact_center_;
+  mutable Eigen::MatrixXd exact_matrix_;
+  mutable bool exact_ok_ = false;
   mutable std::vector<double> values_;
   mutable int evaluations_ = 0;
   mutable std::vector<Remembered> remembered_;
@@ -435,13 +474,19 @@ PassOutcome solve(ModelCost& cost, const ModelEvaluator& model, std::vector<doub
 
 FitResult fit_least_squares(const std::vector<FitParameter>& parameters, int residual_count,
                             const ResidualFunction& residuals, const FitOptions& options) {
+  return fit_least_squares(parameters, residual_count, residuals, JacobianFunction(), options);
+}
+
+FitResult fit_least_squares(const std::vector<FitParameter>& parameters, int residual_count,
+                            const ResidualFunction& residuals, const JacobianFunction& exact_jacobian,
+                            const FitOptions& options) {
   check_problem(parameters, residual_count);
   if (!(options.initial_damping > 0.0 && std::isfinite(options.initial_damping))) {
     throw std::invalid_argument("fit: initial_damping must be positive and finite");
   }
   const int n = static_cast<int>(parameters.size());
   const Coordinates coords{&parameters};
-  ModelEvaluator model(coords, residual_count, residuals);
+  ModelEvaluator model(coords, residual_count, residuals, exact_jacobian ? &exact_jacobian : nullptr);
   ModelCost cost(model, n, residual_count, options.difference_step, options.central_differences);
 
   std::vector<double> internal(static_cast<size_t>(n));

@@ -43,6 +43,14 @@ struct FitParameter {
 /// treats that step as rejected and shrinks its trust region.
 using ResidualFunction = std::function<bool(const std::vector<double>& values, std::vector<double>& residuals)>;
 
+/// Residuals and their exact derivatives at once (for models that propagate sensitivities, e.g.
+/// the FEM trajectory fit): fill `residuals` as a ResidualFunction does and `jacobian` (resized
+/// by the function to residual count x parameter count) with d residual_i / d value_j, with
+/// respect to each parameter's value (not its log). Return false when the model cannot be
+/// evaluated there.
+using JacobianFunction =
+    std::function<bool(const std::vector<double>& values, std::vector<double>& residuals, Eigen::MatrixXd& jacobian)>;
+
 enum class RobustLoss {
   none,    ///< plain least squares
   huber,   ///< quadratic within loss_scale, linear beyond (default: mild outliers)
@@ -114,6 +122,13 @@ struct FitResult {
 FitResult fit_least_squares(const std::vector<FitParameter>& parameters, int residual_count,
                             const ResidualFunction& residuals, const FitOptions& options = {});
 
+/// The same fit with the Jacobian from `jacobian` instead of finite differences (each Jacobian is
+/// one call; trial points still use `residuals`, which may be cheaper). difference_step and
+/// central_differences are then unused. FitResult::evaluations counts both kinds of call.
+FitResult fit_least_squares(const std::vector<FitParameter>& parameters, int residual_count,
+                            const ResidualFunction& residuals, const JacobianFunction& jacobian,
+                            const FitOptions& options = {});
+
 /// The names this file had when only the FEM estimators used it (pliant::host::fem::...);
 /// kept so that code written against them still builds.
 namespace fem {
@@ -121,6 +136,7 @@ using pliant::host::fit_least_squares;
 using pliant::host::FitOptions;
 using pliant::host::FitParameter;
 using pliant::host::FitResult;
+using pliant::host::JacobianFunction;
 using pliant::host::ResidualFunction;
 using pliant::host::RobustLoss;
 }  // namespace fem

@@ -60,8 +60,33 @@
 // frequency only, the decay is attributed to rayleigh_beta. Then Levenberg-Marquardt
 // (fit_least_squares) on the full trajectory from there.
 //
-// Parallelism: fit_least_squares evaluates sequentially. The residual function used here keeps
-// a cache of recent simulations and, while the optimiser waits for one, runs on the other
+// Jacobian (TrajectoryEstimateOptions::jacobian). By default the simulation carries forward
+// sensitivities d x / d log(theta) through every Newmark substep (the step's own factorized
+// matrix, one back substitution and one element pass per unknown per substep; the derivation is
+// at the top of src/fem_estimation/trajectory_sensitivity.hpp), so one simulation gives the whole
+// Jacobian instead of p + 1. They are the derivatives of the converged implicit step with the
+// step's own tangent (the rotation derivative dropped): exact for small rotations, and on the
+// Table 1 bar within about 1e-3 relative of finite differences of the one-iteration step
+// (fem_estimate_dynamic_test). They cover one modulus for the whole body and the Rayleigh
+// coefficients with Newmark, at-rest initial velocity and no applied wrench; material maps,
+// backward Euler, velocities from the data and applied wrenches use finite differences
+// (TrajectoryEstimate::jacobian says which and why).
+//
+// Stopping at the warm start (stop_when_explained, default on). When the warm start's whitened
+// residuals already explain the data, sum r^2 / (residual_count - p) <= 1 + 3 sqrt(2 / dof) (the
+// chi-square of pure noise at position_noise_m exceeds this with probability ~0.1 %), the fit
+// takes one Levenberg-Marquardt step from there and stops; the standard deviations come from the
+// start's Jacobian and the residual scatter after the step. The report (stopped_at_start,
+// stop_reason, start_chi_square_per_dof) says so. A start that does not explain the data is
+// fitted as before. With position_noise_m too large for the data this stops early; it is the
+// noise the caller declares.
+//
+// Parallelism: fit_least_squares evaluates sequentially. With sensitivities, each trial point is
+// one simulation with its sensitivities (the Jacobian the optimiser asks for once it accepts the
+// point); a second, plain simulation of it on the other core would answer a little sooner but
+// cost CPU time on every accepted step, so there is no parallel work left and `threads` only
+// matters with finite differences. There,
+// the residual function keeps a cache of recent simulations and, while the optimiser waits for one, runs on the other
 // threads the simulations the optimiser's finite differences will ask for next (the points
 // value * exp(+difference_step), and with central differences value * exp(-difference_step), of
 // each log-scale parameter in turn). A wrong guess only costs an otherwise idle core. Results
@@ -70,9 +95,11 @@
 //
 // Units SI: m, s, Pa, 1/s (rayleigh_alpha), s (rayleigh_beta). Host code: allocates, starts
 // threads, throws std::invalid_argument for unusable problems or options. Cost: one simulation
-// is frame_count * substeps implicit steps (one sparse factorization each); a fit takes about
-// (p + 1) / threads simulations per iteration for p unknowns ((2 p + 1) / threads with central
-// differences), plus the warm start (a modal analysis and small fits, well under a second).
+// is frame_count * substeps implicit steps (one sparse factorization each). With sensitivities a
+// fit takes one simulation with them per iteration (about twice a plain one; two in all when the
+// warm start explains the data), with finite differences about (p + 1) / threads plain ones for p
+// unknowns ((2 p + 1) / threads with central differences); plus the warm start (a modal analysis
+// and small fits, well under a second). Table 1 bar, one modulus: 21 s CPU (before: 61 s).
 #pragma once
 
 #include <string>
@@ -108,6 +135,28 @@ std::vector<Eigen::VectorXd> simulate_trajectory(const FemRecordingProblem& prob
                                                  const Eigen::Ref<const Eigen::VectorXd>& element_youngs_modulus_pa,
                                                  double rayleigh_alpha, double rayleigh_beta,
                                                  const TrajectorySimulationOptions& options = {});
+
+/// How the trajectory fit gets its Jacobian (see "Jacobian" above).
+enum class TrajectoryJacobian {
+  automatic,           ///< sensitivities where they are available, finite differences otherwise
+  sensitivities,       ///< forward sensitivities; std::invalid_argument where not available
+  finite_differences,  ///< p + 1 simulations per Jacobian (FitOptions::difference_step)
+};
+
+/// simulate_trajectory with the forward sensitivities the fit uses (see "Jacobian" above).
+struct TrajectorySensitivities {
+  std::vector<Eigen::VectorXd> position_m;  ///< per frame (3n, m), frame 0 included
+  /// Per frame, d position / d log(youngs_modulus), d log(rayleigh_alpha), d log(rayleigh_beta)
+  /// (three 3n vectors, m).
+  std::vector<std::vector<Eigen::VectorXd>> sensitivity_m;
+};
+
+/// One modulus for every element. Throws std::invalid_argument where sensitivities are not
+/// available (backward Euler, initial velocity from the data, an applied wrench) and like
+/// simulate_trajectory otherwise. Cost: about what the fit's Jacobian run costs.
+TrajectorySensitivities simulate_trajectory_sensitivities(const FemRecordingProblem& problem, double youngs_modulus_pa,
+                                                          double rayleigh_alpha, double rayleigh_beta,
+                                                          const TrajectorySimulationOptions& options = {});
 
 struct TrajectoryEstimateOptions {
   /// Which unknowns to fit (a parameter the recording declares is held fixed regardless).
@@ -152,6 +201,10 @@ struct TrajectoryEstimateOptions {
   }();
   /// Threads running simulations (>= 1); 0: std::thread::hardware_concurrency().
   int threads = 2;
+  TrajectoryJacobian jacobian = TrajectoryJacobian::automatic;
+  /// Stop after one polishing step when the warm start already explains the data within the
+  /// noise (see "Stopping at the warm start" above).
+  bool stop_when_explained = true;
   /// Continuation in time: fit the first fraction of the frames (each in (0, 1), ascending),
   /// starting each fit where the previous one ended, before the whole record. A start that is off
   /// in a frequency cannot then lock onto the wrong period over a long record. Empty (default):
@@ -212,12 +265,21 @@ struct TrajectoryEstimate {
   int evaluations = 0;        ///< residual-function calls of that fit
   int window_iterations = 0;  ///< of the continuation fits on leading windows
   int window_evaluations = 0;
-  int simulations = 0;  ///< forward simulations run (cached repeats not counted;
-                        ///< look-ahead ones counted, used or not)
-  bool converged = false;
-  std::string message;     ///< the optimiser's summary
-  double wall_time_s = 0;  ///< warm start + fit
-  double cpu_time_s = 0;   ///< process CPU time over the same span (all threads)
+  int simulations = 0;     ///< forward simulations run (cached repeats not counted;
+                           ///< look-ahead ones counted, used or not)
+  bool converged = false;  ///< a tolerance was met, or the start explained the data (stopped_at_start)
+  std::string message;     ///< the optimiser's summary (after stop_reason when stopped)
+  /// "sensitivities", or "finite differences (...)" with the reason (the configuration, or
+  /// requested).
+  std::string jacobian;
+  /// Sum of squared whitened residuals at the start over (residual_count - unknowns), and the
+  /// threshold 1 + 3 sqrt(2 / dof) below which the start counts as explaining the data.
+  double start_chi_square_per_dof = 0;
+  double explained_threshold = 0;
+  bool stopped_at_start = false;  ///< one polishing step only (see above)
+  std::string stop_reason;        ///< why it stopped or went on (empty without a warm start)
+  double wall_time_s = 0;         ///< warm start + fit
+  double cpu_time_s = 0;          ///< process CPU time over the same span (all threads)
   FitResult fit;
 };
 

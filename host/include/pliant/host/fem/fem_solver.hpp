@@ -176,6 +176,37 @@ class FemSolver {
   /// Constraint forces after the last step() or solve_static() (3n, N; zero at free nodes).
   const Eigen::VectorXd& reaction_n() const;
 
+  // Forward sensitivities (estimate_dynamic.hpp's exact Jacobian). These reuse the solver's
+  // factor and element pass; they do not change the state of a simulation in progress.
+
+  /// Solves, in place on the free DOFs of `vector` (3n), the system factorized last: after a
+  /// step() of one substep, ((1 + c_d alpha) M + (c_d beta + c_f) K) of that substep's Newton
+  /// iteration (Newmark: c_d = h / 2, c_f = h^2 / 4); after solve_static(), K of its last Newton
+  /// iteration. Constrained DOFs are set to 0. Throws std::logic_error before any factorization.
+  /// Cost: one forward and one backward substitution.
+  void solve_last_factorized(Eigen::Ref<Eigen::VectorXd> vector);
+
+  /// out += scale * K(position_m) u: the corotational tangent (rotation derivative dropped, the
+  /// model's volumetric formulation, current moduli) times u, at every node (3n vectors, every
+  /// node's rows, constrained ones included). Cost: one pass over the elements.
+  void add_tangent_product(const Eigen::Ref<const Eigen::VectorXd>& position_m,
+                           const Eigen::Ref<const Eigen::VectorXd>& u, double scale, Eigen::Ref<Eigen::VectorXd> out);
+
+  /// Several products at once, out[k] += scales[k] * K(position_m) u[k], and, when force_out is
+  /// not null, force_out += force_scale * f_int(position_m): one pass over the elements (each
+  /// rotation computed once) under the element formulation; one pass per product under the
+  /// averaged nodal pressure. Sizes as above; u, scales and out of equal length. With
+  /// `rotation_derivative` (element formulation only; ignored under the nodal pressure) K is the
+  /// exact tangent -d f_int / d x, the polar factor's derivative included.
+  void add_tangent_products(const Eigen::Ref<const Eigen::VectorXd>& position_m,
+                            const std::vector<const Eigen::VectorXd*>& u, const std::vector<double>& scales,
+                            const std::vector<Eigen::VectorXd*>& out, double force_scale, Eigen::VectorXd* force_out,
+                            bool rotation_derivative = false);
+
+  /// out += scale * f_int(position_m) (3n, N): the elastic forces on the nodes. One element pass.
+  void add_internal_force(const Eigen::Ref<const Eigen::VectorXd>& position_m, double scale,
+                          Eigen::Ref<Eigen::VectorXd> out);
+
   /// Entries of the Cholesky factor and its supernode count (for reports and benchmarks).
   std::size_t factor_entries() const;
   int supernode_count() const;
