@@ -13,6 +13,7 @@
 
 #include "atomic_write.hpp"
 #include "exit_status.hpp"
+#include "pliant/host/diagnose/noise_floor.hpp"
 #include "pliant/host/fem/fem_recording.hpp"
 #include "pliant/host/fem/material_map.hpp"
 #include "refine_control_points.hpp"
@@ -197,7 +198,8 @@ RefineDone run_refine_job(const RefineJob& job, const RecordingSource& source, c
   const RefinePlan plan = plan_refine(problem, request, job.estimator);
   check_rest_shape(problem, plan, job.rest_frame.value_or(0));
   warn_unused_options(job, plan, warn);
-  const RefineSettings settings = refine_settings(job, plan, problem, control);
+  RefineSettings settings = refine_settings(job, plan, problem, control);
+  settings.position_noise_m = host::estimate_noise_std(recording);
   RefineDone done;
   if (plan.rest_shape) {
     done.rest_mesh = rest_mesh_path(job);

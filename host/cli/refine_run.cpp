@@ -166,6 +166,11 @@ void run_trajectory(const FemRecordingProblem& problem, const RefinePlan& plan, 
   o.initial_youngs_modulus_pa = s.initial_youngs_modulus_pa;
   o.simulation.substeps = s.substeps;
   o.threads = s.threads;
+  if (s.position_noise_m > 0) {
+    o.position_noise_m = s.position_noise_m;
+  } else {
+    o.stop_when_explained = false;  // no noise to compare the start with
+  }
   o.fit.on_iteration = reporter(progress);
   const bool select = plan.material_map && s.select_control_points;
   if (plan.material_map && !select) {
@@ -229,6 +234,7 @@ void run_trajectory(const FemRecordingProblem& problem, const RefinePlan& plan, 
   d["evaluations"] = e.evaluations + e.window_evaluations;
   d["simulations"] = e.simulations;
   d["substeps"] = s.substeps;
+  d["position_noise"] = number(o.position_noise_m);
   d["start_rms"] = number(e.start_residual_rms_m * std::sqrt(3.0));
   d["jacobian"] = e.jacobian;
   d["start_chi_square_per_dof"] = number(e.start_chi_square_per_dof);

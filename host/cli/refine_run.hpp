@@ -46,6 +46,10 @@ struct RefineSettings {
   int rest_frame = 0;                             ///< rest_shape: the static frame
   int threads = 1;                                ///< >= 1
   int substeps = 4;                               ///< trajectory: Newmark substeps per frame interval
+  /// trajectory: the tracks' measured noise per coordinate (m, noise_floor.hpp); the fit's
+  /// whitening and its test of whether the warm start already explains the data. 0 (noise-free
+  /// or unmeasurable tracks): the estimator's default whitening, and no stopping at the start.
+  double position_noise_m = 0;
 };
 
 /// The fitted model at one frame.
