@@ -814,6 +814,15 @@ TrajectoryEstimate estimate_trajectory_parameters(const FemRecordingProblem& pro
     }
   }
 
+  const std::vector<double>& given_moduli = options.initial_control_youngs_modulus_pa;
+  if (!given_moduli.empty()) {
+    if (given_moduli.size() != static_cast<std::size_t>(k)) {
+      throw std::invalid_argument(label + "initial_control_youngs_modulus_pa needs one value per control point");
+    }
+    for (double e : given_moduli) {
+      if (!(e > 0) || !std::isfinite(e)) throw std::invalid_argument(label + "initial control moduli must be > 0");
+    }
+  }
   std::vector<FitParameter> parameters;
   if (fit_modulus) {
     for (int i = 0; i < k; ++i) {
@@ -821,7 +830,8 @@ TrajectoryEstimate estimate_trajectory_parameters(const FemRecordingProblem& pro
       p.name = map ? "youngs_modulus[" + std::to_string(i) + "]" : "youngs_modulus";
       p.lower = options.youngs_modulus_min_pa;
       p.upper = options.youngs_modulus_max_pa;
-      p.initial = inside(start_e, p.lower, p.upper);
+      p.initial =
+          inside(given_moduli.empty() ? start_e : given_moduli[static_cast<std::size_t>(i)], p.lower, p.upper);
       parameters.push_back(p);
     }
   }

@@ -101,6 +101,22 @@ int rescore(std::vector<MaterialMapCandidate>& candidates, double& design) {
   return lowest;
 }
 
+/// The modulus of `fit`'s field at each point: that of the element whose rest centroid is
+/// nearest (the start of a finer map, continued from a coarser one).
+std::vector<double> field_at(const FemRecordingProblem& problem, const TrajectoryEstimate& fit,
+                             const std::vector<Eigen::Vector3d>& points_m) {
+  const std::vector<Eigen::Vector3d> centroids = element_centroids(problem.mesh);
+  std::vector<double> values;
+  for (const Eigen::Vector3d& p : points_m) {
+    std::size_t nearest = 0;
+    for (std::size_t e = 1; e < centroids.size(); ++e) {
+      if ((centroids[e] - p).squaredNorm() < (centroids[nearest] - p).squaredNorm()) nearest = e;
+    }
+    values.push_back(fit.element_youngs_modulus_pa[static_cast<Eigen::Index>(nearest)]);
+  }
+  return values;
+}
+
 std::vector<int> undetermined_points(const TrajectoryEstimate& fit, double relative_sd) {
   std::vector<int> out;
   for (std::size_t i = 0; i < fit.control_youngs_modulus_pa.size(); ++i) {
@@ -123,6 +139,15 @@ MaterialMapSelection select_material_map(const FemRecordingProblem& problem,
     if (count > problem.mesh.tet_count()) break;
     TrajectoryEstimateOptions o = fit_options;
     o.control_points_m = place_control_points(problem.mesh, count);
+    if (!fits.empty() && count > 1) {
+      // Continued from the best map so far: a finer map starts where the coarser one ended, so
+      // it cannot end worse by falling into another basin.
+      const TrajectoryEstimate& best = fits[uz(out.chosen)];
+      o.initial_control_youngs_modulus_pa = field_at(problem, best, o.control_points_m);
+      o.initial_rayleigh_alpha = best.rayleigh_alpha;
+      o.initial_rayleigh_beta = best.rayleigh_beta;
+      o.warm_start = false;
+    }
     const std::clock_t started = std::clock();
     TrajectoryEstimate fit = estimate_trajectory_parameters(problem, o);
     const ResidualSeries series = residual_series(problem, fit, o.simulation);

@@ -176,6 +176,11 @@ struct TrajectoryEstimateOptions {
   /// Starting values without a warm start, and the warm start's reference modulus E0.
   /// initial_youngs_modulus_pa = 0: problem.material.youngs_modulus_pa.
   double initial_youngs_modulus_pa = 0;
+  /// Starting modulus of each control point (Pa, one per control_points_m entry, each > 0), used
+  /// instead of the warm start's uniform value; empty: the warm start or initial_youngs_modulus_pa.
+  /// A coarser map's fitted field evaluated at the new points continues a fit from there
+  /// (material_map_selection.hpp).
+  std::vector<double> initial_control_youngs_modulus_pa;
   double initial_rayleigh_alpha = 0.1;  ///< 1/s
   double initial_rayleigh_beta = 1e-3;  ///< s
 
