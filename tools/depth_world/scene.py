@@ -52,16 +52,7 @@ def geo_text(shape, footprint, lc):
             s = footprint["side"]
             lines.append(f"Rectangle(100) = {{{cx - s / 2}, {cy - s / 2}, {h}, {s}, {s}}};")
         lines.append("BooleanFragments{ Volume{1}; Delete; }{ Surface{100}; Delete; }")
-    lines += [
-        f"Mesh.CharacteristicLengthMax = {lc};",
-        f"Mesh.CharacteristicLengthMin = {0.4 * lc};",
-        "Mesh.CharacteristicLengthFromCurvature = 0;",
-        "Mesh.CharacteristicLengthFromPoints = 0;",
-        "Mesh.Optimize = 1;",
-        "Mesh.RandomSeed = 1;",
-        "General.NumThreads = 1;",
-        "Mesh.MshFileVersion = 2.2;",
-    ]
+    lines += mesh.mesh_options(lc)
     return "\n".join(lines) + "\n"
 
 

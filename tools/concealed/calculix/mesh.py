@@ -42,7 +42,14 @@ def _geo_text(shape, tool, lc, region=None):
         tools.append("Volume{%d};" % (200 if region["kind"] == "sphere" else 201))
     if tools:
         lines.append("BooleanFragments{ Volume{1}; Delete; }{ " + " ".join(tools) + " Delete; }")
-    lines += [
+    lines += mesh_options(lc)
+    return "\n".join(lines) + "\n"
+
+
+def mesh_options(lc):
+    """The gmsh settings of every mesh of these scenes: element sizes from lc (m), optimised,
+    deterministic (one thread, a fixed seed), written as ASCII .msh version 2.2."""
+    return [
         f"Mesh.CharacteristicLengthMax = {lc};",
         f"Mesh.CharacteristicLengthMin = {0.4 * lc};",
         "Mesh.CharacteristicLengthFromCurvature = 0;",
@@ -52,7 +59,6 @@ def _geo_text(shape, tool, lc, region=None):
         "General.NumThreads = 1;",
         "Mesh.MshFileVersion = 2.2;",
     ]
-    return "\n".join(lines) + "\n"
 
 
 def _read_msh2(path):
