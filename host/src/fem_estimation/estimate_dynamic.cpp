@@ -830,8 +830,7 @@ TrajectoryEstimate estimate_trajectory_parameters(const FemRecordingProblem& pro
       p.name = map ? "youngs_modulus[" + std::to_string(i) + "]" : "youngs_modulus";
       p.lower = options.youngs_modulus_min_pa;
       p.upper = options.youngs_modulus_max_pa;
-      p.initial =
-          inside(given_moduli.empty() ? start_e : given_moduli[static_cast<std::size_t>(i)], p.lower, p.upper);
+      p.initial = inside(given_moduli.empty() ? start_e : given_moduli[static_cast<std::size_t>(i)], p.lower, p.upper);
       parameters.push_back(p);
     }
   }
