@@ -110,6 +110,8 @@ TEST(MaterialMapSelection, BadOptionsAreRefused) {
   EXPECT_THROW(select_material_map(problem, fit_options(), options), std::invalid_argument);
   options.counts = {0, 1};
   EXPECT_THROW(select_material_map(problem, fit_options(), options), std::invalid_argument);
+  options.counts = {100000};  // more control points than tetrahedra
+  EXPECT_THROW(select_material_map(problem, fit_options(), options), std::invalid_argument);
   options.counts = {1, 2};
   options.patience = 0;
   EXPECT_THROW(select_material_map(problem, fit_options(), options), std::invalid_argument);

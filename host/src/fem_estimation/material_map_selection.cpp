@@ -167,6 +167,9 @@ MaterialMapSelection select_material_map(const FemRecordingProblem& problem,
     worse_in_a_row = improved ? 0 : worse_in_a_row + 1;
     if (worse_in_a_row >= options.patience) break;
   }
+  if (fits.empty()) {
+    throw std::invalid_argument("material map selection: every count exceeds the mesh's tetrahedra");
+  }
   out.estimate = std::move(fits[uz(out.chosen)]);
   out.undetermined = undetermined_points(out.estimate, options.undetermined_relative_sd);
   return out;

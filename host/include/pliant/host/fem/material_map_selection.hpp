@@ -19,7 +19,8 @@
 // start), so that a finer map starts no worse than the coarser one; on the 8-slab bar a 2-point
 // fit from the uniform warm start ended ten times worse than the uniform fit. The search stops
 // after `patience` counts in a row whose BIC is not lower than the best so far, or when a count
-// exceeds the number of tetrahedra. The chosen fit is returned whole.
+// exceeds the number of tetrahedra (none left: std::invalid_argument). The chosen fit is returned
+// whole.
 //
 // Undetermined regions. A control point of the chosen map whose modulus has no finite standard
 // deviation, or one larger than undetermined_relative_sd times its value, is listed in
